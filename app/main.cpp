@@ -1,0 +1,101 @@
+// pdflab: the viewer (default) and the headless commands. See INTERFACE.md / README.md.
+#include "app/assets.h"
+#include "app/render_command.h"
+#include "renderer/error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+
+#ifdef PDFLAB_HAVE_VIEWER
+#include "app/viewer.h"
+#endif
+
+namespace {
+
+constexpr int kBadInput = 2;
+constexpr int kInternalFailure = 1;
+
+int report_input_error(const std::string& what) {
+  std::fprintf(stderr, "pdflab: error: %s\n", what.c_str());
+  return kBadInput;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"pdflab: a laboratory for importance sampling in path tracing"};
+  app.set_version_flag("--version", std::string(PDFLAB_VERSION));
+  app.require_subcommand(0, 1);
+
+  // The viewer's options (no subcommand).
+  std::string view_scene, view_strategy = "mix:cosine=0.5,light=0.5", screenshot;
+  std::uint32_t view_spp = 0;
+  app.add_option("--scene", view_scene, "Scene file (default: the book's Cornell box)");
+  app.add_option("--strategy", view_strategy, "Sampling strategy (see README)");
+  app.add_option("--spp", view_spp, "With --screenshot: samples per pixel to render before saving")
+      ->check(CLI::Range(1u, 1u << 30));
+  app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
+
+  pdflab::RenderOptions ro;
+  CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
+  render->add_option("--scene", ro.scene, "Scene file (JSON)")->required();
+  render->add_option("--strategy", ro.strategy, "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5")
+      ->required();
+  render->add_option("--spp", ro.spp, "Samples per pixel")->required()->check(CLI::Range(1u, 1u << 30));
+  render->add_option("--out", ro.out, "Output image: .png (tone-mapped), .pfm (linear), .hdr")->required();
+  render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)");
+  render->add_option("--threads", ro.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  render->add_option("--width", ro.width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
+  render->add_option("--height", ro.height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
+  render->add_option("--stats-json", ro.stats_json, "Also write the summary as JSON");
+  render->add_option("--transfer", ro.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
+      ->check(CLI::IsMember({"gamma2", "srgb"}));
+  render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab render --help' for usage.\n", e.what());
+    return kBadInput;
+  }
+
+  try {
+    if (render->parsed()) return pdflab::run_render(ro);
+#ifdef PDFLAB_HAVE_VIEWER
+    pdflab::ViewerOptions vo;
+    vo.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;
+    vo.strategy = view_strategy;
+    vo.spp = view_spp;
+    vo.screenshot = screenshot;
+    return pdflab::run_viewer(vo);
+#else
+    // Built without the viewer: render the default scene headlessly instead.
+    pdflab::RenderOptions fallback;
+    fallback.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;
+    fallback.strategy = view_strategy;
+    fallback.spp = view_spp ? view_spp : 64;
+    fallback.out = screenshot.empty() ? "pdflab.png" : screenshot;
+    const int status = pdflab::run_render(fallback);
+    std::printf("pdflab was built without the viewer; the image is at %s\n",
+                std::filesystem::absolute(fallback.out).c_str());
+    return status;
+#endif
+  } catch (const pdflab::InputError& e) {
+    return report_input_error(e.what());
+  } catch (const pdflab::IoError& e) {
+    std::fprintf(stderr, "pdflab: error: %s\n", e.what());
+    return kInternalFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pdflab: internal error: %s\n", e.what());
+    return kInternalFailure;
+  }
+}

@@ -1,0 +1,110 @@
+#include "app/render_command.h"
+
+#include "renderer/error.h"
+#include "renderer/film/image_io.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+#include <thread>
+
+namespace pdflab {
+
+namespace {
+
+void draw_progress(const SessionStats& st, std::uint32_t target) {
+  constexpr int kWidth = 32;
+  const int filled = static_cast<int>(st.progress * kWidth);
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.resize(kWidth, '.');
+  const double remaining = st.progress > 0.0 ? st.seconds * (1.0 - st.progress) / st.progress : 0.0;
+  std::fprintf(stderr, "\r[%s] %3d%%  %u/%u spp  %.1f s  %.2f M samples/s  ~%.0f s left ", bar.c_str(),
+               static_cast<int>(st.progress * 100.0), st.spp, target, st.seconds, st.samples_per_second * 1e-6,
+               remaining);
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& o) {
+  // Everything the user typed is checked before any work starts.
+  if (o.spp == 0) throw InputError("--spp must be at least 1");
+  const ImageFormat format = image_format_for(o.out);
+  (void)format;
+  check_output_path(o.out);
+  if (!o.stats_json.empty()) check_output_path(o.stats_json);
+  Transfer transfer;
+  if (o.transfer == "gamma2") transfer = Transfer::Gamma2;
+  else if (o.transfer == "srgb") transfer = Transfer::Srgb;
+  else throw InputError("--transfer must be 'gamma2' or 'srgb', not '" + o.transfer + "'");
+  if (o.threads < 0 || o.threads > 1024) throw InputError("--threads must be in 0..1024 (0: all cores)");
+
+  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
+  if (o.width != 0) scene->camera.width = o.width;
+  if (o.height != 0) scene->camera.height = o.height;
+  scene->camera.prepare();
+  const Strategy strategy = Strategy::parse(o.strategy);
+  (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
+
+  if (!strategy.is_unbiased() && !o.quiet)
+    std::fprintf(stderr,
+                 "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
+                 "targets, so it omits indirect light\n",
+                 strategy.to_string().c_str());
+
+  RenderSession session(o.threads);
+  RenderSettings settings;
+  settings.scene = scene;
+  settings.strategy = strategy;
+  settings.seed = o.seed;
+  settings.target_spp = o.spp;
+  session.set_settings(settings);
+
+  const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
+  while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 1000)))
+    if (show_progress) draw_progress(session.stats(), o.spp);
+  const SessionStats st = session.stats();
+  if (show_progress) {
+    draw_progress(st, o.spp);
+    std::fputc('\n', stderr);
+  }
+
+  const Film film = session.copy_film();
+  write_image(o.out, film.mean_rgb(), film.width(), film.height(), transfer);
+
+  const auto& d = st.dropped.by_reason;
+  if (!o.stats_json.empty()) {
+    nlohmann::json j;
+    j["scene"] = scene->name;
+    j["scene_file"] = o.scene;
+    j["strategy"] = strategy.to_string();
+    j["unbiased"] = strategy.is_unbiased();
+    j["width"] = film.width();
+    j["height"] = film.height();
+    j["spp"] = st.spp;
+    j["seed"] = o.seed;
+    j["threads"] = session.thread_count();
+    j["seconds"] = st.seconds;
+    j["samples"] = st.samples;
+    j["samples_per_second"] = st.samples_per_second;
+    j["dropped"] = {{"total", st.dropped.total()}};
+    for (int r = 0; r < kDropReasonCount; ++r)
+      j["dropped"][std::string(drop_reason_name(static_cast<DropReason>(r)))] = d[r];
+    j["output"] = o.out;
+    const std::string text = j.dump(2) + "\n";
+    write_file_atomic(o.stats_json, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+  }
+
+  std::printf("%u spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %llu samples dropped "
+              "(pdf_zero %llu, pdf_not_finite %llu, radiance_not_finite %llu) -> %s\n",
+              st.spp, film.width(), film.height(), st.seconds, st.samples_per_second * 1e-6, session.thread_count(),
+              static_cast<unsigned long long>(st.dropped.total()), static_cast<unsigned long long>(d[0]),
+              static_cast<unsigned long long>(d[1]), static_cast<unsigned long long>(d[2]), o.out.c_str());
+  return 0;
+}
+
+}  // namespace pdflab

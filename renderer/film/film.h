@@ -1,0 +1,49 @@
+#pragma once
+// Per-pixel accumulation: sum and sum of squares in double, and a sample count.
+// Tiles are disjoint, so workers write without locks; one sample order per pixel
+// (by sample index) keeps sums bit-identical for any thread count.
+#include "renderer/math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace pdflab {
+
+class Film {
+ public:
+  Film() = default;
+  Film(int width, int height) { reset(width, height); }
+
+  void reset(int width, int height);
+  void clear();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  std::size_t pixel_count() const { return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_); }
+
+  void add(std::size_t pixel, const Vec3& value) {
+    double* s = &sum_[3 * pixel];
+    double* q = &sum_sq_[3 * pixel];
+    const double r = value.x, g = value.y, b = value.z;
+    s[0] += r; s[1] += g; s[2] += b;
+    q[0] += r * r; q[1] += g * g; q[2] += b * b;
+    ++count_[pixel];
+  }
+
+  std::uint32_t count(std::size_t pixel) const { return count_[pixel]; }
+  // Mean radiance per channel (zero where no sample landed yet).
+  void mean(std::size_t pixel, double out[3]) const;
+  // Variance of the mean per channel: (E[x^2] - E[x]^2) / (n - 1); zero for n < 2.
+  void variance_of_mean(std::size_t pixel, double out[3]) const;
+
+  // The mean image as float RGB, row 0 at the top.
+  std::vector<float> mean_rgb() const;
+  void mean_rgb(std::vector<float>& out) const;
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<double> sum_, sum_sq_;
+  std::vector<std::uint32_t> count_;
+};
+
+}  // namespace pdflab

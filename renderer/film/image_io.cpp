@@ -1,0 +1,156 @@
+#include "renderer/film/image_io.h"
+
+#include "renderer/error.h"
+
+#include <stb_image_write.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+namespace pdflab {
+
+namespace fs = std::filesystem;
+
+ImageFormat image_format_for(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".png") return ImageFormat::Png;
+  if (ext == ".pfm") return ImageFormat::Pfm;
+  if (ext == ".hdr") return ImageFormat::Hdr;
+  throw InputError("output file '" + path + "': unknown image format '" + ext + "' (use .png, .pfm or .hdr)");
+}
+
+void check_output_path(const std::string& path) {
+  if (path.empty()) throw InputError("output file name is empty");
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw InputError("output file '" + path + "': folder '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError("output file '" + path + "': folder '" + dir.string() + "' is not writable");
+  if (fs::is_directory(path, ec)) throw InputError("output file '" + path + "' is a folder");
+}
+
+void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes) {
+  static std::atomic<unsigned> counter{0};
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
+  const bool wrote = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  const int write_errno = errno;
+  const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+  const int flush_errno = errno;
+  const bool closed = std::fclose(f) == 0;
+  if (!wrote || !flushed || !closed) {
+    std::remove(tmp.c_str());
+    throw IoError("cannot write '" + path + "': " + std::strerror(!wrote ? write_errno : flush_errno));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    std::remove(tmp.c_str());
+    throw IoError("cannot write '" + path + "': " + std::strerror(e));
+  }
+}
+
+std::uint8_t tone_map_channel(float linear, Transfer transfer, float exposure) {
+  float x = linear * exposure;
+  if (!(x > 0.0f)) return 0;  // also NaN
+  if (transfer == Transfer::Gamma2) {
+    x = std::sqrt(x);
+  } else {
+    x = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  }
+  // The book's mapping: clamp to [0, 0.999], scale by 256.
+  return static_cast<std::uint8_t>(256.0f * std::clamp(x, 0.0f, 0.999f));
+}
+
+namespace {
+
+void append_to_vector(void* context, void* data, int size) {
+  auto* out = static_cast<std::vector<std::uint8_t>*>(context);
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  out->insert(out->end(), bytes, bytes + size);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_png(const std::vector<float>& rgb, int width, int height, Transfer transfer,
+                                     float exposure) {
+  std::vector<std::uint8_t> pixels(rgb.size());
+  for (std::size_t i = 0; i < rgb.size(); ++i) pixels[i] = tone_map_channel(rgb[i], transfer, exposure);
+  std::vector<std::uint8_t> out;
+  if (!stbi_write_png_to_func(append_to_vector, &out, width, height, 3, pixels.data(), width * 3))
+    throw IoError("PNG encoding failed");
+  return out;
+}
+
+std::vector<std::uint8_t> encode_pfm(const std::vector<float>& rgb, int width, int height) {
+  // PFM: rows bottom to top; a negative scale means little-endian floats.
+  const std::string header = "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
+  std::vector<std::uint8_t> out(header.begin(), header.end());
+  const std::size_t row_bytes = static_cast<std::size_t>(width) * 3 * sizeof(float);
+  out.resize(header.size() + row_bytes * static_cast<std::size_t>(height));
+  std::uint8_t* dst = out.data() + header.size();
+  for (int y = height - 1; y >= 0; --y, dst += row_bytes)
+    std::memcpy(dst, rgb.data() + static_cast<std::size_t>(y) * width * 3, row_bytes);
+  static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
+  return out;
+}
+
+std::vector<std::uint8_t> encode_hdr(const std::vector<float>& rgb, int width, int height) {
+  std::vector<std::uint8_t> out;
+  if (!stbi_write_hdr_to_func(append_to_vector, &out, width, height, 3, rgb.data()))
+    throw IoError("HDR encoding failed");
+  return out;
+}
+
+void write_image(const std::string& path, const std::vector<float>& rgb, int width, int height, Transfer transfer) {
+  std::vector<std::uint8_t> bytes;
+  switch (image_format_for(path)) {
+    case ImageFormat::Png: bytes = encode_png(rgb, width, height, transfer); break;
+    case ImageFormat::Pfm: bytes = encode_pfm(rgb, width, height); break;
+    case ImageFormat::Hdr: bytes = encode_hdr(rgb, width, height); break;
+  }
+  write_file_atomic(path, bytes);
+}
+
+std::vector<float> read_pfm(const std::string& path, int& width, int& height) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot read '" + path + "': " + std::strerror(errno));
+  std::string magic;
+  double scale = 0.0;
+  long w = 0, h = 0;
+  in >> magic >> w >> h >> scale;
+  if (!in || magic != "PF" || w <= 0 || h <= 0 || w > 16384 || h > 16384 || scale == 0.0)
+    throw InputError("'" + path + "' is not a colour PFM image (expected 'PF', width, height, scale)");
+  in.get();  // the single whitespace byte after the scale
+  width = static_cast<int>(w);
+  height = static_cast<int>(h);
+  const std::size_t row = static_cast<std::size_t>(w) * 3;
+  std::vector<float> rgb(row * static_cast<std::size_t>(h));
+  for (long y = h - 1; y >= 0; --y) {
+    in.read(reinterpret_cast<char*>(rgb.data() + static_cast<std::size_t>(y) * row),
+            static_cast<std::streamsize>(row * sizeof(float)));
+    if (!in) throw InputError("'" + path + "': PFM data is truncated");
+  }
+  if (scale > 0.0) {  // big-endian file
+    for (float& f : rgb) {
+      std::uint32_t u;
+      std::memcpy(&u, &f, 4);
+      u = __builtin_bswap32(u);
+      std::memcpy(&f, &u, 4);
+    }
+  }
+  return rgb;
+}
+
+}  // namespace pdflab

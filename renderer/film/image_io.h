@@ -1,0 +1,41 @@
+#pragma once
+// Image files. Every writer goes through write_file_atomic: a temporary file in
+// the same folder, then rename, so a crash or a full disk never leaves half a file.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+
+enum class ImageFormat { Png, Pfm, Hdr };
+enum class Transfer { Gamma2, Srgb };  // Gamma2: the book's sqrt
+
+// From the extension (case-insensitive). Throws InputError naming the path.
+ImageFormat image_format_for(const std::string& path);
+
+// Throws InputError when the folder of `path` does not exist or is not writable.
+void check_output_path(const std::string& path);
+
+// Throws IoError (with the path and the system's reason) on failure; the target
+// is then untouched.
+void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes);
+
+// Linear float RGB, row 0 at the top.
+std::vector<std::uint8_t> encode_png(const std::vector<float>& rgb, int width, int height, Transfer transfer,
+                                     float exposure = 1.0f);
+std::vector<std::uint8_t> encode_pfm(const std::vector<float>& rgb, int width, int height);
+std::vector<std::uint8_t> encode_hdr(const std::vector<float>& rgb, int width, int height);
+
+// Tone-maps and writes in the format named by the extension.
+void write_image(const std::string& path, const std::vector<float>& rgb, int width, int height,
+                 Transfer transfer = Transfer::Gamma2);
+
+// Reads a PFM written by encode_pfm (or any little/big-endian colour PFM).
+// Throws InputError on a malformed file.
+std::vector<float> read_pfm(const std::string& path, int& width, int& height);
+
+// 8-bit value of a linear channel as the PNG writer maps it.
+std::uint8_t tone_map_channel(float linear, Transfer transfer, float exposure = 1.0f);
+
+}  // namespace pdflab

@@ -1,0 +1,133 @@
+#include "renderer/integrator/integrator.h"
+
+namespace pdflab {
+
+std::string_view drop_reason_name(DropReason r) {
+  switch (r) {
+    case DropReason::PdfZero: return "pdf_zero";
+    case DropReason::PdfNotFinite: return "pdf_not_finite";
+    case DropReason::RadianceNotFinite: return "radiance_not_finite";
+    default: return "unknown";
+  }
+}
+
+namespace {
+
+inline Vec3 reflect(const Vec3& v, const Vec3& n) { return v - n * (2.0f * dot(v, n)); }
+
+inline Vec3 random_unit_vector(Rng& rng) {
+  const float u1 = rng.uniform();
+  const float u2 = rng.uniform();
+  return sample_uniform_sphere(u1, u2).direction;
+}
+
+// Schlick's approximation to the Fresnel reflectance.
+inline float schlick(float cosine, float eta_ratio) {
+  float r0 = (1.0f - eta_ratio) / (1.0f + eta_ratio);
+  r0 *= r0;
+  const float m = 1.0f - cosine;
+  const float m2 = m * m;
+  return r0 + (1.0f - r0) * m2 * m2 * m;
+}
+
+}  // namespace
+
+Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
+  Vec3 radiance(0.0f);
+  Vec3 throughput(1.0f);
+  for (int depth = 0; depth < scene.max_depth; ++depth) {
+    Hit hit;
+    if (!intersect(scene, ray, kInf, hit)) {
+      radiance += throughput * scene.background;
+      break;
+    }
+    const Material& m = scene.materials[hit.material];
+    const float cos_in = dot(ray.direction, hit.normal);
+    const bool front_face = cos_in < 0.0f;
+    const Vec3 normal = front_face ? hit.normal : -hit.normal;  // faces the incoming ray
+
+    if (m.type == MaterialType::DiffuseLight) {
+      if (front_face || m.two_sided) radiance += throughput * m.emit;
+      break;  // lights do not scatter
+    }
+
+    if (m.type == MaterialType::Lambertian) {
+      const DirectionSample ds = plan.sample(hit.point, normal, rng);
+      if (!(ds.pdf > 0.0f)) {
+        drops.add(std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
+        break;
+      }
+      if (ds.pdf == kInf) {
+        drops.add(DropReason::PdfNotFinite);
+        break;
+      }
+      const float cosine = dot(ds.direction, normal);
+      if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
+      throughput *= m.albedo * (cosine * kInvPi / ds.pdf);
+      ray = spawn_ray(hit.point, hit.normal, ds.direction);
+    } else if (m.type == MaterialType::Metal) {
+      Vec3 dir = reflect(ray.direction, normal);
+      if (m.fuzz > 0.0f) dir = normalize(dir + random_unit_vector(rng) * m.fuzz);
+      if (dot(dir, normal) <= 0.0f) break;  // fuzz pushed it under the surface: absorbed
+      throughput *= m.albedo;
+      ray = spawn_ray(hit.point, hit.normal, dir);
+    } else {  // Dielectric
+      const float eta_ratio = front_face ? 1.0f / m.ior : m.ior;
+      const float cos_theta = std::fmin(-dot(ray.direction, normal), 1.0f);
+      const float sin2_theta = std::fmax(0.0f, 1.0f - cos_theta * cos_theta);
+      const float sin2_t = eta_ratio * eta_ratio * sin2_theta;
+      Vec3 dir;
+      if (sin2_t > 1.0f || schlick(cos_theta, eta_ratio) > rng.uniform()) {
+        dir = reflect(ray.direction, normal);
+      } else {
+        const Vec3 perp = (ray.direction + normal * cos_theta) * eta_ratio;
+        const Vec3 parallel = normal * -std::sqrt(std::fmax(0.0f, 1.0f - sin2_t));
+        dir = normalize(perp + parallel);
+      }
+      ray = spawn_ray(hit.point, hit.normal, dir);
+    }
+  }
+  if (!is_finite(radiance)) {
+    drops.add(DropReason::RadianceNotFinite);
+    return Vec3(0.0f);
+  }
+  return radiance;
+}
+
+namespace {
+
+// Van der Corput (base 2) and the second Sobol dimension: together a (0,2)-sequence.
+inline std::uint32_t reverse_bits(std::uint32_t v) {
+  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
+  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+  return (v >> 16) | (v << 16);
+}
+inline std::uint32_t sobol_dim2(std::uint32_t index) {
+  std::uint32_t result = 0;
+  for (std::uint32_t v = 1u << 31; index; index >>= 1, v ^= v >> 1)
+    if (index & 1u) result ^= v;
+  return result;
+}
+
+}  // namespace
+
+Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,
+                         std::uint32_t sample_index, DropCounts& drops) {
+  const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(scene.camera.width) +
+                              static_cast<std::uint64_t>(x);
+  // A random digital shift per pixel keeps the (0,2)-sequence's stratification
+  // and decorrelates neighbouring pixels.
+  const std::uint64_t scramble = mix64(mix64(seed ^ 0x5bd1e995u) + pixel);
+  const std::uint32_t sx = reverse_bits(sample_index) ^ static_cast<std::uint32_t>(scramble);
+  const std::uint32_t sy = sobol_dim2(sample_index) ^ static_cast<std::uint32_t>(scramble >> 32);
+  const float jx = static_cast<float>(sx >> 8) * 0x1.0p-24f;
+  const float jy = static_cast<float>(sy >> 8) * 0x1.0p-24f;
+
+  Rng rng = Rng::for_sample(seed, pixel, sample_index);
+  const Ray ray = scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy);
+  return trace_path(scene, plan, ray, rng, drops);
+}
+
+}  // namespace pdflab

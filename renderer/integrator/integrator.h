@@ -1,0 +1,47 @@
+#pragma once
+// The book's estimator, iterative: L = emission + albedo * scattering_pdf * L_i / pdf
+// at diffuse hits; metal and dielectric follow their own direction.
+#include "renderer/math.h"
+#include "renderer/sampling/rng.h"
+#include "renderer/sampling/strategy.h"
+#include "renderer/scene/scene.h"
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+namespace pdflab {
+
+// Why a sample was dropped (contributed nothing but still counted as a sample).
+enum class DropReason : std::uint8_t {
+  PdfZero,           // the strategy's pdf was zero or negative for its own sample
+  PdfNotFinite,      // NaN or infinite pdf (a shading point in a light's plane, on the light)
+  RadianceNotFinite, // the path's estimate overflowed or became NaN
+  Count
+};
+inline constexpr int kDropReasonCount = static_cast<int>(DropReason::Count);
+std::string_view drop_reason_name(DropReason r);
+
+struct DropCounts {
+  std::array<std::uint64_t, kDropReasonCount> by_reason{};
+  void add(DropReason r) { ++by_reason[static_cast<int>(r)]; }
+  std::uint64_t total() const {
+    std::uint64_t t = 0;
+    for (auto c : by_reason) t += c;
+    return t;
+  }
+  DropCounts& operator+=(const DropCounts& o) {
+    for (int i = 0; i < kDropReasonCount; ++i) by_reason[i] += o.by_reason[i];
+    return *this;
+  }
+};
+
+// Radiance along one camera ray. Returns zero (and counts) when the estimate is not finite.
+Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops);
+
+// One pixel sample: position within the pixel from a scrambled (0,2)-sequence
+// (stratified at every power of two), then the path.
+Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,
+                         std::uint32_t sample_index, DropCounts& drops);
+
+}  // namespace pdflab

@@ -1,0 +1,40 @@
+#pragma once
+// Small vector helpers on top of GLM. Everything in the renderer is float;
+// accumulation (film, statistics) is double.
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+
+namespace pdflab {
+
+using Vec3 = glm::vec3;
+
+inline constexpr float kPi = std::numbers::pi_v<float>;
+inline constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+inline constexpr float kInf = std::numeric_limits<float>::infinity();
+
+inline float dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline float length_squared(const Vec3& a) { return dot(a, a); }
+inline float length(const Vec3& a) { return std::sqrt(dot(a, a)); }
+inline Vec3 normalize(const Vec3& a) { return a * (1.0f / length(a)); }
+inline float max_abs_component(const Vec3& a) {
+  return std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
+}
+inline bool is_finite(const Vec3& a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+inline float clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
+
+struct Ray {
+  Vec3 origin;
+  Vec3 direction;  // unit length everywhere in the renderer
+};
+
+}  // namespace pdflab

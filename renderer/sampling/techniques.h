@@ -1,0 +1,142 @@
+#pragma once
+// Every sampling technique as a pair of free functions: sample_X(...) returns a
+// unit direction with its solid-angle pdf, X_pdf(...) evaluates that pdf for any
+// unit direction. The pairs must agree; tests/test_chi_square.cpp checks each.
+#include "renderer/math.h"
+#include "renderer/sampling/onb.h"
+#include "renderer/scene/scene.h"
+
+namespace pdflab {
+
+struct DirectionSample {
+  Vec3 direction;
+  float pdf;
+};
+
+// ---- Hemisphere and sphere techniques (relative to a shading normal) -------
+
+inline constexpr float kInv2Pi = 0.5f * kInvPi;
+inline constexpr float kInv4Pi = 0.25f * kInvPi;
+
+// Cosine-weighted hemisphere: p(w) = cos(theta) / pi.
+inline DirectionSample sample_cosine_hemisphere(const Onb& frame, float u1, float u2) {
+  const float r = std::sqrt(u1);
+  const float phi = 2.0f * kPi * u2;
+  const float z = std::sqrt(std::fmax(0.0f, 1.0f - u1));
+  const Vec3 local(r * std::cos(phi), r * std::sin(phi), z);
+  return {frame.to_world(local), z * kInvPi};
+}
+inline float cosine_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
+  const float c = dot(normal, direction);
+  return c > 0.0f ? c * kInvPi : 0.0f;
+}
+
+// Uniform hemisphere: p(w) = 1 / (2 pi) above the surface.
+inline DirectionSample sample_uniform_hemisphere(const Onb& frame, float u1, float u2) {
+  const float z = 1.0f - u1;  // (0, 1]: never exactly tangent
+  const float r = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u2;
+  return {frame.to_world(Vec3(r * std::cos(phi), r * std::sin(phi), z)), kInv2Pi};
+}
+inline float uniform_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
+  return dot(normal, direction) > 0.0f ? kInv2Pi : 0.0f;
+}
+
+// Uniform sphere: p(w) = 1 / (4 pi). Half its samples point below the surface.
+inline DirectionSample sample_uniform_sphere(float u1, float u2) {
+  const float z = 1.0f - 2.0f * u1;
+  const float r = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u2;
+  return {Vec3(r * std::cos(phi), r * std::sin(phi), z), kInv4Pi};
+}
+inline float uniform_sphere_pdf() { return kInv4Pi; }
+
+// ---- Area sampling of a quad (the book's quad::random / pdf_value) ---------
+// A uniform point on the quad, converted to solid angle: p = d^2 / (|cos| A).
+
+inline DirectionSample sample_quad_area(const Quad& quad, const Vec3& origin, float u1, float u2) {
+  const Vec3 to_point = quad.q + quad.u * u1 + quad.v * u2 - origin;
+  const float dist2 = dot(to_point, to_point);
+  const float dist = std::sqrt(dist2);
+  const Vec3 direction = to_point * (1.0f / dist);
+  const float cosine = std::fabs(dot(direction, quad.normal));
+  // dist2 == 0 (origin on the sampled point) or cosine == 0 (origin in the
+  // quad's plane) give an infinite or NaN pdf; the integrator drops and counts them.
+  return {direction, dist2 / (cosine * quad.area)};
+}
+
+// Distance along a unit ray to the quad, or a negative value when it misses.
+inline float quad_hit_distance(const Quad& quad, const Vec3& origin, const Vec3& direction) {
+  const float denom = dot(quad.normal, direction);
+  if (denom == 0.0f) return -1.0f;
+  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;
+  if (!(t > 0.0f)) return -1.0f;
+  const Vec3 rel = origin + direction * t - quad.q;
+  const float a = dot(rel, quad.alpha_axis);
+  const float b = dot(rel, quad.beta_axis);
+  if (a < 0.0f || a > 1.0f || b < 0.0f || b > 1.0f) return -1.0f;
+  return t;
+}
+
+inline float quad_area_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {
+  const float t = quad_hit_distance(quad, origin, direction);
+  if (t < 0.0f) return 0.0f;
+  const float cosine = std::fabs(dot(direction, quad.normal));
+  return t * t / (cosine * quad.area);
+}
+
+// ---- Cone sampling of a sphere (the book's sphere::random / pdf_value) ----
+
+struct SphereCone {
+  Vec3 axis;                 // unit, from the origin to the centre
+  float cos_max;             // cosine of the cone's half angle
+  float one_minus_cos_max;   // computed without cancellation
+  bool inside;               // origin inside the sphere: every direction hits it
+};
+
+// 1 - cos(theta_max) = sin^2 / (1 + cos): no cancellation for small or far spheres.
+inline SphereCone sphere_cone(const Sphere& sphere, const Vec3& origin) {
+  const Vec3 to_center = sphere.center - origin;
+  const float dist2 = dot(to_center, to_center);
+  const float r2 = sphere.radius * sphere.radius;
+  SphereCone cone{};
+  if (dist2 <= r2) {
+    cone.inside = true;
+    cone.axis = Vec3(0.0f, 0.0f, 1.0f);
+    cone.cos_max = -1.0f;
+    cone.one_minus_cos_max = 2.0f;
+    return cone;
+  }
+  cone.axis = to_center * (1.0f / std::sqrt(dist2));
+  const float sin2_max = r2 / dist2;
+  cone.cos_max = std::sqrt(std::fmax(0.0f, 1.0f - sin2_max));
+  cone.one_minus_cos_max = sin2_max / (1.0f + cone.cos_max);
+  cone.inside = false;
+  return cone;
+}
+
+// From inside the sphere the whole sphere of directions is the target: pdf 1/(4 pi).
+inline DirectionSample sample_sphere_cone(const Sphere& sphere, const Vec3& origin, float u1, float u2) {
+  const SphereCone cone = sphere_cone(sphere, origin);
+  if (cone.inside) return sample_uniform_sphere(u1, u2);
+  const float h = u1 * cone.one_minus_cos_max;  // 1 - cos(theta), uniform in [0, 1 - cos_max)
+  const float cos_theta = 1.0f - h;
+  const float sin_theta = std::sqrt(std::fmax(0.0f, h * (2.0f - h)));
+  const float phi = 2.0f * kPi * u2;
+  const Onb frame(cone.axis);
+  const Vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
+  return {normalize(frame.to_world(local)), 1.0f / (2.0f * kPi * cone.one_minus_cos_max)};
+}
+
+inline float sphere_cone_pdf(const Sphere& sphere, const Vec3& origin, const Vec3& direction) {
+  const SphereCone cone = sphere_cone(sphere, origin);
+  if (cone.inside) return kInv4Pi;
+  // Inside the cone iff 1 - cos(angle to axis) <= 1 - cos_max; the left side is
+  // computed as |w - axis|^2 / 2, which keeps its precision for tiny cones.
+  const Vec3 diff = direction - cone.axis;
+  const float one_minus_cos = 0.5f * dot(diff, diff);
+  if (one_minus_cos > cone.one_minus_cos_max) return 0.0f;
+  return 1.0f / (2.0f * kPi * cone.one_minus_cos_max);
+}
+
+}  // namespace pdflab

@@ -1,0 +1,121 @@
+#include "renderer/scene/scene.h"
+
+namespace pdflab {
+
+Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material) {
+  Quad quad{};
+  quad.q = q;
+  quad.u = u;
+  quad.v = v;
+  const Vec3 n = cross(u, v);
+  const float n2 = dot(n, n);
+  quad.area = std::sqrt(n2);
+  quad.normal = n * (1.0f / quad.area);
+  quad.plane_d = dot(quad.normal, q);
+  const Vec3 w = n * (1.0f / n2);
+  // p = q + a u + b v  =>  a = w . (rel x v) = rel . (v x w),  b = rel . (w x u)
+  quad.alpha_axis = cross(v, w);
+  quad.beta_axis = cross(w, u);
+  quad.material = material;
+  return quad;
+}
+
+void Camera::prepare() {
+  const float theta = vfov_degrees * (kPi / 180.0f);
+  const float viewport_height = 2.0f * std::tan(theta * 0.5f);
+  const float viewport_width = viewport_height * (static_cast<float>(width) / static_cast<float>(height));
+  const Vec3 w = normalize(lookfrom - lookat);
+  const Vec3 u = normalize(cross(vup, w));
+  const Vec3 v = cross(w, u);
+  du = u * (viewport_width / static_cast<float>(width));
+  dv = -v * (viewport_height / static_cast<float>(height));
+  const Vec3 upper_left = -w - u * (viewport_width * 0.5f) + v * (viewport_height * 0.5f);
+  pixel00 = upper_left;  // relative to lookfrom; pixel (x, y) spans [x, x+1) x [y, y+1)
+}
+
+Ray Camera::generate_ray(float px, float py) const {
+  return Ray{lookfrom, normalize(pixel00 + du * px + dv * py)};
+}
+
+namespace {
+
+inline bool hit_quad(const Quad& quad, const Ray& ray, float t_max, float& t_out) {
+  const float denom = dot(quad.normal, ray.direction);
+  if (std::fabs(denom) < 1e-9f) return false;  // parallel to the plane
+  const float t = (quad.plane_d - dot(quad.normal, ray.origin)) / denom;
+  if (!(t > 0.0f && t < t_max)) return false;
+  const Vec3 rel = ray.origin + ray.direction * t - quad.q;
+  const float a = dot(rel, quad.alpha_axis);
+  const float b = dot(rel, quad.beta_axis);
+  if (a < 0.0f || a > 1.0f || b < 0.0f || b > 1.0f) return false;
+  t_out = t;
+  return true;
+}
+
+inline bool hit_sphere(const Sphere& sphere, const Ray& ray, float t_max, float& t_out) {
+  // Distance along the ray to the closest approach, and the squared distance of
+  // that point from the centre: stable for far and small spheres, unlike b^2 - 4ac.
+  const Vec3 f = ray.origin - sphere.center;
+  const float b = -dot(f, ray.direction);
+  const Vec3 closest = f + ray.direction * b;
+  const float disc = sphere.radius * sphere.radius - dot(closest, closest);
+  if (disc < 0.0f) return false;
+  const float h = std::sqrt(disc);
+  float t = b - h;
+  if (!(t > 0.0f && t < t_max)) {
+    t = b + h;
+    if (!(t > 0.0f && t < t_max)) return false;
+  }
+  t_out = t;
+  return true;
+}
+
+}  // namespace
+
+bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
+  int best_quad = -1, best_sphere = -1;
+  float closest = t_max;
+  const int nq = static_cast<int>(scene.quads.size());
+  for (int i = 0; i < nq; ++i) {
+    float t;
+    if (hit_quad(scene.quads[i], ray, closest, t)) {
+      closest = t;
+      best_quad = i;
+    }
+  }
+  const int ns = static_cast<int>(scene.spheres.size());
+  for (int i = 0; i < ns; ++i) {
+    float t;
+    if (hit_sphere(scene.spheres[i], ray, closest, t)) {
+      closest = t;
+      best_sphere = i;
+    }
+  }
+  if (best_sphere >= 0) {
+    const Sphere& s = scene.spheres[best_sphere];
+    hit.t = closest;
+    hit.point = ray.origin + ray.direction * closest;
+    hit.normal = (hit.point - s.center) * (1.0f / s.radius);
+    hit.material = s.material;
+    return true;
+  }
+  if (best_quad >= 0) {
+    const Quad& q = scene.quads[best_quad];
+    hit.t = closest;
+    hit.point = ray.origin + ray.direction * closest;
+    hit.normal = q.normal;
+    hit.material = q.material;
+    return true;
+  }
+  return false;
+}
+
+Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
+  // 2^-18 relative: about 64 float ulps of the largest coordinate, plus an
+  // absolute floor for points near the origin.
+  const float offset = 1e-4f + 4e-6f * max_abs_component(point);
+  const float side = dot(direction, geometric_normal) >= 0.0f ? offset : -offset;
+  return Ray{point + geometric_normal * side, direction};
+}
+
+}  // namespace pdflab

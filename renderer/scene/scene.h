@@ -1,0 +1,93 @@
+#pragma once
+// The scene as flat arrays of plain structs. Boxes are already six quads and
+// rotations/translations are baked into the geometry by the loader.
+#include "renderer/math.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+
+enum class MaterialType : std::uint8_t { Lambertian, Metal, Dielectric, DiffuseLight };
+
+struct Material {
+  MaterialType type = MaterialType::Lambertian;
+  Vec3 albedo{0.0f};
+  Vec3 emit{0.0f};
+  float fuzz = 0.0f;
+  float ior = 1.0f;
+  bool two_sided = false;  // diffuse_light only
+};
+
+// A parallelogram: corner q, edges u and v. Front face normal is u x v.
+struct Quad {
+  Vec3 q, u, v;
+  Vec3 normal;      // unit u x v
+  float plane_d;    // dot(normal, q)
+  Vec3 alpha_axis;  // dot(p - q, alpha_axis) is the coordinate along u in [0, 1]
+  Vec3 beta_axis;   // likewise along v
+  float area;
+  std::uint32_t material;
+};
+
+struct Sphere {
+  Vec3 center;
+  float radius;
+  std::uint32_t material;
+};
+
+// Builds a quad with its derived plane data. Throws nothing: callers validate u x v != 0.
+Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material);
+
+// An object that the `light` techniques aim at (the book's `lights` list).
+struct Target {
+  enum class Kind : std::uint8_t { Quad, Sphere } kind;
+  std::uint32_t index;  // into Scene::quads or Scene::spheres
+};
+
+struct Camera {
+  int width = 600;
+  int height = 600;
+  float vfov_degrees = 40.0f;
+  Vec3 lookfrom{278.0f, 278.0f, -800.0f};
+  Vec3 lookat{278.0f, 278.0f, 0.0f};
+  Vec3 vup{0.0f, 1.0f, 0.0f};
+
+  // Derived by prepare(): a ray through pixel (x + dx, y + dy) has direction
+  // pixel00 + (x + dx) * du + (y + dy) * dv (then normalised).
+  Vec3 pixel00, du, dv;
+  void prepare();
+  Ray generate_ray(float px, float py) const;  // px, py in pixel units from the top-left corner
+};
+
+struct Scene {
+  std::string name;
+  Camera camera;
+  int max_depth = 50;
+  Vec3 background{0.0f};
+  std::vector<Material> materials;
+  std::vector<std::string> material_names;
+  std::vector<Quad> quads;
+  std::vector<Sphere> spheres;
+  std::vector<Target> targets;
+  float scale = 1.0f;  // largest coordinate magnitude: sets the ray offset
+};
+
+struct Hit {
+  float t;
+  Vec3 point;
+  Vec3 normal;  // geometric, outward (quads: u x v)
+  std::uint32_t material;
+};
+
+// Closest intersection along the ray with t in (0, t_max). Origins are offset by
+// the caller (spawn_ray), so no t_min epsilon is needed here.
+bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit);
+
+// A new ray leaving `point` in `direction`, moved off the surface along the
+// normal on the side the direction goes, by an offset that scales with the
+// coordinates' magnitude (float spacing grows with it).
+Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction);
+
+}  // namespace pdflab

@@ -1,0 +1,283 @@
+#include "renderer/scene/scene_loader.h"
+
+#include "renderer/error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace pdflab {
+
+using json = nlohmann::json;
+
+namespace {
+
+constexpr int kMaxImageSide = 16384;
+
+// A JSON value with the path that leads to it, for error messages.
+class Node {
+ public:
+  Node(const json& value, std::string path, const std::string& origin) : v_(value), path_(std::move(path)), origin_(origin) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InputError(origin_ + ": " + (path_.empty() ? std::string("top level") : path_) + ": " + what);
+  }
+
+  const json& value() const { return v_; }
+  const std::string& path() const { return path_; }
+
+  Node child(const std::string& key) const {
+    return Node(v_.at(key), path_.empty() ? key : path_ + "." + key, origin_);
+  }
+  Node element(std::size_t i) const { return Node(v_.at(i), path_ + "[" + std::to_string(i) + "]", origin_); }
+  bool has(const std::string& key) const { return v_.contains(key); }
+
+  void expect_object() const {
+    if (!v_.is_object()) fail("expected an object, found " + std::string(v_.type_name()));
+  }
+  void expect_array() const {
+    if (!v_.is_array()) fail("expected an array, found " + std::string(v_.type_name()));
+  }
+  Node require(const std::string& key) const {
+    if (!has(key)) fail("missing key '" + key + "'");
+    return child(key);
+  }
+  void allow_only(const std::set<std::string>& keys) const {
+    for (auto it = v_.begin(); it != v_.end(); ++it)
+      if (!keys.count(it.key())) {
+        std::string list;
+        for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+        fail("unknown key '" + it.key() + "' (allowed: " + list + ")");
+      }
+  }
+
+  double number() const {
+    if (!v_.is_number()) fail("expected a number, found " + std::string(v_.type_name()));
+    const double d = v_.get<double>();
+    if (!std::isfinite(d)) fail("must be a finite number");
+    if (std::fabs(d) > 1e30) fail("magnitude is too large for single precision");
+    return d;
+  }
+  float real() const { return static_cast<float>(number()); }
+  int integer(int lo, int hi) const {
+    if (!v_.is_number_integer()) fail("expected an integer, found " + std::string(v_.type_name()));
+    const auto i = v_.get<long long>();
+    if (i < lo || i > hi) fail("must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", found " + std::to_string(i));
+    return static_cast<int>(i);
+  }
+  bool boolean() const {
+    if (!v_.is_boolean()) fail("expected true or false, found " + std::string(v_.type_name()));
+    return v_.get<bool>();
+  }
+  std::string string() const {
+    if (!v_.is_string()) fail("expected a string, found " + std::string(v_.type_name()));
+    return v_.get<std::string>();
+  }
+  Vec3 vec3() const {
+    if (!v_.is_array() || v_.size() != 3) fail("expected an array of 3 numbers");
+    return {element(0).real(), element(1).real(), element(2).real()};
+  }
+
+ private:
+  const json& v_;
+  std::string path_;
+  const std::string& origin_;
+};
+
+Vec3 nonnegative_colour(const Node& n) {
+  const Vec3 c = n.vec3();
+  if (c.x < 0.0f || c.y < 0.0f || c.z < 0.0f) n.fail("colour components must be >= 0");
+  return c;
+}
+
+void parse_camera(const Node& node, Scene& scene) {
+  node.expect_object();
+  node.allow_only({"width", "height", "vfov", "lookfrom", "lookat", "vup", "max_depth", "background"});
+  Camera& cam = scene.camera;
+  cam.width = node.require("width").integer(1, kMaxImageSide);
+  cam.height = node.require("height").integer(1, kMaxImageSide);
+  const Node vfov = node.require("vfov");
+  cam.vfov_degrees = vfov.real();
+  if (!(cam.vfov_degrees > 0.0f && cam.vfov_degrees < 180.0f)) vfov.fail("must be between 0 and 180 degrees (exclusive)");
+  cam.lookfrom = node.require("lookfrom").vec3();
+  cam.lookat = node.require("lookat").vec3();
+  cam.vup = node.has("vup") ? node.child("vup").vec3() : Vec3(0.0f, 1.0f, 0.0f);
+  const Vec3 view = cam.lookat - cam.lookfrom;
+  if (length_squared(view) == 0.0f) node.fail("lookfrom and lookat are the same point");
+  const Vec3 side = cross(cam.vup, normalize(view));
+  if (!(length(side) > 1e-6f * length(cam.vup))) node.fail("vup is zero or parallel to the viewing direction");
+  scene.max_depth = node.has("max_depth") ? node.child("max_depth").integer(1, 10000) : 50;
+  scene.background = node.has("background") ? nonnegative_colour(node.child("background")) : Vec3(0.0f);
+  cam.prepare();
+}
+
+Material parse_material(const Node& node) {
+  node.expect_object();
+  const Node type_node = node.require("type");
+  const std::string type = type_node.string();
+  Material m;
+  if (type == "lambertian") {
+    node.allow_only({"type", "albedo"});
+    m.type = MaterialType::Lambertian;
+    m.albedo = nonnegative_colour(node.require("albedo"));
+  } else if (type == "metal") {
+    node.allow_only({"type", "albedo", "fuzz"});
+    m.type = MaterialType::Metal;
+    m.albedo = nonnegative_colour(node.require("albedo"));
+    if (node.has("fuzz")) {
+      const Node f = node.child("fuzz");
+      m.fuzz = f.real();
+      if (!(m.fuzz >= 0.0f && m.fuzz <= 1.0f)) f.fail("must be in 0..1");
+    }
+  } else if (type == "dielectric") {
+    node.allow_only({"type", "ior"});
+    m.type = MaterialType::Dielectric;
+    const Node ior = node.require("ior");
+    m.ior = ior.real();
+    if (!(m.ior > 0.0f)) ior.fail("must be > 0");
+  } else if (type == "diffuse_light") {
+    node.allow_only({"type", "emit", "two_sided"});
+    m.type = MaterialType::DiffuseLight;
+    m.emit = nonnegative_colour(node.require("emit"));
+    m.two_sided = node.has("two_sided") && node.child("two_sided").boolean();
+  } else {
+    type_node.fail("unknown material type '" + type + "' (lambertian, metal, dielectric, diffuse_light)");
+  }
+  return m;
+}
+
+// rotate_y as in the book: x' = cos x + sin z, z' = -sin x + cos z.
+Vec3 rotate_y(const Vec3& p, float cos_t, float sin_t) {
+  return {cos_t * p.x + sin_t * p.z, p.y, -sin_t * p.x + cos_t * p.z};
+}
+
+void check_quad(const Node& node, const Vec3& u, const Vec3& v) {
+  const Vec3 n = cross(u, v);
+  const float scale = length(u) * length(v);
+  if (!(scale > 0.0f) || !(length(n) > 1e-7f * scale)) node.fail("degenerate quad: u x v is zero (u and v are parallel or zero)");
+}
+
+void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& materials, Scene& scene) {
+  node.expect_object();
+  const Node type_node = node.require("type");
+  const std::string type = type_node.string();
+  const Node mat_node = node.require("material");
+  const std::string mat_name = mat_node.string();
+  const auto mat_it = materials.find(mat_name);
+  if (mat_it == materials.end()) mat_node.fail("unknown material '" + mat_name + "'");
+  const std::uint32_t mat = mat_it->second;
+  const bool emitter = scene.materials[mat].type == MaterialType::DiffuseLight;
+  const bool importance = node.has("importance") ? node.child("importance").boolean() : emitter;
+
+  if (type == "quad") {
+    node.allow_only({"type", "q", "u", "v", "material", "importance"});
+    const Vec3 q = node.require("q").vec3(), u = node.require("u").vec3(), v = node.require("v").vec3();
+    check_quad(node, u, v);
+    if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(scene.quads.size())});
+    scene.quads.push_back(make_quad(q, u, v, mat));
+  } else if (type == "sphere") {
+    node.allow_only({"type", "center", "radius", "material", "importance"});
+    const Vec3 c = node.require("center").vec3();
+    const Node r = node.require("radius");
+    const float radius = r.real();
+    if (!(radius > 0.0f)) r.fail("must be > 0");
+    if (importance) scene.targets.push_back({Target::Kind::Sphere, static_cast<std::uint32_t>(scene.spheres.size())});
+    scene.spheres.push_back({c, radius, mat});
+  } else if (type == "box") {
+    node.allow_only({"type", "min", "max", "rotate_y", "translate", "material", "importance"});
+    const Vec3 lo = node.require("min").vec3(), hi = node.require("max").vec3();
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) node.fail("box 'max' must exceed 'min' on every axis");
+    const float angle = node.has("rotate_y") ? node.child("rotate_y").real() * (kPi / 180.0f) : 0.0f;
+    const Vec3 offset = node.has("translate") ? node.child("translate").vec3() : Vec3(0.0f);
+    const float c = std::cos(angle), s = std::sin(angle);
+    const Vec3 dx(hi.x - lo.x, 0, 0), dy(0, hi.y - lo.y, 0), dz(0, 0, hi.z - lo.z);
+    // Six faces, each with an outward front normal (u x v).
+    const Vec3 faces[6][3] = {
+        {{lo.x, lo.y, hi.z}, dx, dy},   // +z
+        {{hi.x, lo.y, hi.z}, -dz, dy},  // +x
+        {{hi.x, lo.y, lo.z}, -dx, dy},  // -z
+        {{lo.x, lo.y, lo.z}, dz, dy},   // -x
+        {{lo.x, hi.y, hi.z}, dx, -dz},  // +y
+        {{lo.x, lo.y, lo.z}, dx, dz},   // -y
+    };
+    for (const auto& f : faces) {
+      if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(scene.quads.size())});
+      scene.quads.push_back(make_quad(rotate_y(f[0], c, s) + offset, rotate_y(f[1], c, s), rotate_y(f[2], c, s), mat));
+    }
+  } else {
+    type_node.fail("unknown object type '" + type + "' (quad, box, sphere)");
+  }
+}
+
+std::string line_and_column(const std::string& text, std::size_t byte) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+
+}  // namespace
+
+Scene load_scene_text(const std::string& text, const std::string& origin) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."; keep the reason.
+    std::string reason = e.what();
+    const auto colon = reason.find(": ");
+    reason = colon == std::string::npos ? reason : reason.substr(colon + 2);
+    throw InputError(origin + ": JSON syntax error at " + line_and_column(text, e.byte) + ": " + reason);
+  }
+  Node root(doc, "", origin);
+  root.expect_object();
+  root.allow_only({"name", "description", "camera", "materials", "objects"});
+
+  Scene scene;
+  scene.name = root.has("name") ? root.child("name").string() : origin;
+  if (root.has("description")) (void)root.child("description").string();
+  parse_camera(root.require("camera"), scene);
+
+  const Node mats = root.require("materials");
+  mats.expect_object();
+  std::map<std::string, std::uint32_t> by_name;
+  for (auto it = mats.value().begin(); it != mats.value().end(); ++it) {
+    by_name[it.key()] = static_cast<std::uint32_t>(scene.materials.size());
+    scene.materials.push_back(parse_material(mats.child(it.key())));
+    scene.material_names.push_back(it.key());
+  }
+
+  const Node objects = root.require("objects");
+  objects.expect_array();
+  if (objects.value().empty()) objects.fail("the scene has no objects");
+  for (std::size_t i = 0; i < objects.value().size(); ++i) parse_object(objects.element(i), by_name, scene);
+
+  float scale = max_abs_component(scene.camera.lookfrom);
+  for (const Quad& q : scene.quads)
+    scale = std::fmax(scale, std::fmax(max_abs_component(q.q), max_abs_component(q.q + q.u + q.v)));
+  for (const Sphere& s : scene.spheres) scale = std::fmax(scale, max_abs_component(s.center) + s.radius);
+  scene.scale = scale;
+  return scene;
+}
+
+Scene load_scene_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot read scene '" + path + "': " + std::strerror(errno));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw InputError("cannot read scene '" + path + "': read error");
+  return load_scene_text(buffer.str(), path);
+}
+
+}  // namespace pdflab

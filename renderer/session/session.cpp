@@ -1,0 +1,245 @@
+#include "renderer/session/session.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace pdflab {
+
+using Clock = std::chrono::steady_clock;
+
+RenderSession::RenderSession(int threads) {
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  workers_.reserve(static_cast<std::size_t>(threads));
+  for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { worker_main(); });
+}
+
+RenderSession::~RenderSession() {
+  {
+    std::lock_guard lk(mutex_);
+    quit_ = true;
+    generation_.fetch_add(1);  // workers inside a pass stop at their next tile
+  }
+  work_cv_.notify_all();
+  for (auto& t : workers_) t.join();
+}
+
+void RenderSession::set_settings(RenderSettings settings) {
+  if (!settings.scene) throw std::invalid_argument("RenderSession: settings without a scene");
+  const SamplingPlan plan = SamplingPlan::make(settings.strategy, *settings.scene);  // may throw InputError
+  {
+    std::lock_guard lk(mutex_);
+    generation_.fetch_add(1);
+    if (pass_open_) {
+      // Workers drop their tiles; the last one out applies these settings.
+      pending_ = true;
+      pending_settings_ = std::move(settings);
+      pending_plan_ = plan;
+    } else {
+      apply_settings_locked(std::move(settings), plan);
+      if (!paused_) start_pass_locked();
+    }
+  }
+  done_cv_.notify_all();
+}
+
+RenderSettings RenderSession::settings() const {
+  std::lock_guard lk(mutex_);
+  return pending_ ? pending_settings_ : settings_;
+}
+
+void RenderSession::apply_settings_locked(RenderSettings settings, const SamplingPlan& plan) {
+  settings_ = std::move(settings);
+  plan_ = plan;
+  plan_.scene = settings_.scene.get();
+  const Camera& cam = settings_.scene->camera;
+  if (film_.width() != cam.width || film_.height() != cam.height) {
+    film_.reset(cam.width, cam.height);
+  } else {
+    film_.clear();
+  }
+  spp_done_ = 0;
+  samples_done_ = 0;
+  drops_ = DropCounts{};
+  seconds_before_ = 0.0;
+  running_clock_ = false;
+  next_pass_spp_ = 1;
+  pass_.generation = generation_.load();
+}
+
+void RenderSession::start_pass_locked() {
+  if (!settings_.scene) return;
+  const std::uint32_t target = settings_.target_spp;
+  if (target != 0 && spp_done_ >= target) return;
+  std::uint32_t spp = next_pass_spp_;
+  if (target != 0) spp = std::min(spp, target - spp_done_);
+  const Camera& cam = settings_.scene->camera;
+  pass_.id += 1;
+  pass_.generation = generation_.load();
+  pass_.first_sample = spp_done_;
+  pass_.spp = spp;
+  pass_.tiles_x = (cam.width + kTile - 1) / kTile;
+  pass_.tiles = pass_.tiles_x * ((cam.height + kTile - 1) / kTile);
+  next_tile_.store(0);
+  tiles_finished_.store(0);
+  pass_open_ = true;
+  pass_started_ = Clock::now();
+  if (!running_clock_) {
+    running_clock_ = true;
+    resumed_at_ = pass_started_;
+  }
+  work_cv_.notify_all();
+}
+
+void RenderSession::finish_pass_locked() {
+  pass_open_ = false;
+  const auto now = Clock::now();
+  if (pending_) {
+    pending_ = false;
+    apply_settings_locked(std::move(pending_settings_), pending_plan_);
+    if (!paused_) start_pass_locked();
+    done_cv_.notify_all();
+    return;
+  }
+  const Camera& cam = settings_.scene->camera;
+  spp_done_ += pass_.spp;
+  samples_done_ += static_cast<std::uint64_t>(pass_.spp) * film_.pixel_count();
+
+  // Publish the image for the viewer: the UI thread only ever takes image_mutex_.
+  std::vector<float> rgb;
+  film_.mean_rgb(rgb);
+  {
+    std::lock_guard ik(image_mutex_);
+    image_.swap(rgb);
+    image_width_ = cam.width;
+    image_height_ = cam.height;
+    ++image_version_;
+  }
+
+  // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
+  const double pass_ms = std::chrono::duration<double, std::milli>(now - pass_started_).count();
+  if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;
+  if (pass_ms > 120.0 && next_pass_spp_ > 1) next_pass_spp_ /= 2;
+
+  const bool done = settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
+  if (done || paused_) {
+    seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
+    running_clock_ = false;
+  } else {
+    start_pass_locked();
+  }
+  done_cv_.notify_all();
+}
+
+void RenderSession::worker_main() {
+  std::uint64_t seen_pass = 0;
+  std::unique_lock lk(mutex_);
+  for (;;) {
+    work_cv_.wait(lk, [&] { return quit_ || (pass_open_ && pass_.id != seen_pass); });
+    if (quit_) return;
+    const Pass pass = pass_;
+    seen_pass = pass.id;
+    ++inside_;
+    lk.unlock();
+
+    DropCounts local;
+    for (;;) {
+      const int tile = next_tile_.fetch_add(1, std::memory_order_relaxed);
+      if (tile >= pass.tiles) break;
+      if (generation_.load(std::memory_order_relaxed) != pass.generation) break;
+      render_tile(pass, tile, local);
+      tiles_finished_.fetch_add(1, std::memory_order_relaxed);
+    }
+
+    lk.lock();
+    if (pass.generation == generation_.load()) drops_ += local;
+    if (--inside_ == 0 && pass_open_ && pass_.id == pass.id) finish_pass_locked();
+  }
+}
+
+void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
+  const Scene& scene = *settings_.scene;
+  const int x0 = (tile % pass.tiles_x) * kTile;
+  const int y0 = (tile / pass.tiles_x) * kTile;
+  const int x1 = std::min(x0 + kTile, scene.camera.width);
+  const int y1 = std::min(y0 + kTile, scene.camera.height);
+  const std::uint64_t seed = settings_.seed;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +
+                                static_cast<std::size_t>(x);
+      for (std::uint32_t s = pass.first_sample; s < pass.first_sample + pass.spp; ++s)
+        film_.add(pixel, render_pixel_sample(scene, plan_, seed, x, y, s, drops));
+    }
+  }
+}
+
+void RenderSession::set_paused(bool paused) {
+  {
+    std::lock_guard lk(mutex_);
+    if (paused_ == paused) return;
+    paused_ = paused;
+    if (!paused_ && !pass_open_) start_pass_locked();
+  }
+  done_cv_.notify_all();
+}
+
+double RenderSession::elapsed_locked() const {
+  double s = seconds_before_;
+  if (running_clock_) s += std::chrono::duration<double>(Clock::now() - resumed_at_).count();
+  return s;
+}
+
+SessionStats RenderSession::stats() const {
+  std::lock_guard lk(mutex_);
+  SessionStats st;
+  st.generation = generation_.load();
+  st.spp = spp_done_;
+  st.seconds = elapsed_locked();
+  std::uint64_t partial = 0;
+  double pass_fraction = 0.0;
+  if (pass_open_ && pass_.tiles > 0 && pass_.generation == generation_.load()) {
+    pass_fraction = static_cast<double>(tiles_finished_.load()) / pass_.tiles;
+    partial = static_cast<std::uint64_t>(pass_fraction * pass_.spp * static_cast<double>(film_.pixel_count()));
+  }
+  st.samples = samples_done_ + partial;
+  st.samples_per_second = st.seconds > 0.0 ? static_cast<double>(st.samples) / st.seconds : 0.0;
+  const std::uint32_t target = settings_.target_spp;
+  st.done = target != 0 && spp_done_ >= target && !pending_;
+  if (target != 0) st.progress = std::min(1.0, (spp_done_ + pass_fraction * pass_.spp) / target);
+  st.dropped = drops_;
+  st.paused = paused_;
+  return st;
+}
+
+bool RenderSession::wait_until_done(std::chrono::milliseconds timeout) {
+  std::unique_lock lk(mutex_);
+  auto done = [&] {
+    return !pending_ && !pass_open_ && settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
+  };
+  if (timeout == std::chrono::milliseconds::max()) {
+    done_cv_.wait(lk, done);
+    return true;
+  }
+  return done_cv_.wait_for(lk, timeout, done);
+}
+
+bool RenderSession::copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const {
+  std::lock_guard ik(image_mutex_);
+  if (image_version_ == version || image_.empty()) return false;
+  out = image_;
+  width = image_width_;
+  height = image_height_;
+  version = image_version_;
+  return true;
+}
+
+Film RenderSession::copy_film() const {
+  std::unique_lock lk(mutex_);
+  // The film is only consistent between passes: wait for the open one to end.
+  const bool done = settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
+  if (!paused_ && !done) throw std::logic_error("RenderSession::copy_film while rendering");
+  done_cv_.wait(lk, [&] { return !pass_open_; });
+  return film_;
+}
+
+}  // namespace pdflab

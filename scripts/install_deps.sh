@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs pdflab's build, test and viewer dependencies from Debian 12's packages.
+# Skips apt entirely when everything is already present, so repeated runs are fast.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libglfw3-dev libimgui-dev libglm-dev libstb-dev python3-glad python3-jinja2
+  nlohmann-json3-dev libcli11-dev libpcg-cpp-dev
+  libgtest-dev libbenchmark-dev
+  xvfb xauth mesa-utils libgl1-mesa-dri xdotool imagemagick x11-apps
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "Installing: ${missing[*]}"
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
