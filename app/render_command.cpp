@@ -46,7 +46,7 @@ int run_render(const RenderOptions& o) {
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   if (o.width != 0) scene->camera.width = o.width;
   if (o.height != 0) scene->camera.height = o.height;
-  scene->camera.prepare();
+  scene->prepare();
   const Strategy strategy = Strategy::parse(o.strategy);
   (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
 

@@ -24,8 +24,14 @@ inline Vec3 cross(const Vec3& a, const Vec3& b) {
 inline float length_squared(const Vec3& a) { return dot(a, a); }
 inline float length(const Vec3& a) { return std::sqrt(dot(a, a)); }
 inline Vec3 normalize(const Vec3& a) { return a * (1.0f / length(a)); }
+// Plain comparisons: they compile to single instructions, where std::fmax's
+// NaN rules become a library call in the hot path.
+inline float max_of(float a, float b) { return a > b ? a : b; }
+inline float min_of(float a, float b) { return a < b ? a : b; }
+// x if positive, else 0 (also for NaN): the argument of a sqrt that rounding may push below 0.
+inline float positive_part(float x) { return x > 0.0f ? x : 0.0f; }
 inline float max_abs_component(const Vec3& a) {
-  return std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
+  return max_of(std::fabs(a.x), max_of(std::fabs(a.y), std::fabs(a.z)));
 }
 inline bool is_finite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);

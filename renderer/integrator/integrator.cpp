@@ -73,15 +73,15 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       ray = spawn_ray(hit.point, hit.normal, dir);
     } else {  // Dielectric
       const float eta_ratio = front_face ? 1.0f / m.ior : m.ior;
-      const float cos_theta = std::fmin(-dot(ray.direction, normal), 1.0f);
-      const float sin2_theta = std::fmax(0.0f, 1.0f - cos_theta * cos_theta);
+      const float cos_theta = min_of(-dot(ray.direction, normal), 1.0f);
+      const float sin2_theta = positive_part(1.0f - cos_theta * cos_theta);
       const float sin2_t = eta_ratio * eta_ratio * sin2_theta;
       Vec3 dir;
       if (sin2_t > 1.0f || schlick(cos_theta, eta_ratio) > rng.uniform()) {
         dir = reflect(ray.direction, normal);
       } else {
         const Vec3 perp = (ray.direction + normal * cos_theta) * eta_ratio;
-        const Vec3 parallel = normal * -std::sqrt(std::fmax(0.0f, 1.0f - sin2_t));
+        const Vec3 parallel = normal * -std::sqrt(positive_part(1.0f - sin2_t));
         dir = normalize(perp + parallel);
       }
       ray = spawn_ray(hit.point, hit.normal, dir);

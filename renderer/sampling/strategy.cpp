@@ -126,6 +126,10 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.scene = &scene;
   plan.target_count = static_cast<int>(scene.targets.size());
   plan.inv_target_count = plan.target_count > 0 ? 1.0f / static_cast<float>(plan.target_count) : 0.0f;
+  for (const Target& t : scene.targets) {
+    if (t.kind == Target::Kind::Quad) plan.quad_targets.push_back(&scene.quads[t.index]);
+    else plan.sphere_targets.push_back(&scene.spheres[t.index]);
+  }
   std::array<float, kTechniqueCount> w = strategy.weights;
   // A light technique with nothing to aim at has no distribution: its weight
   // goes to the other techniques (renormalised below).
@@ -149,31 +153,34 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   return plan;
 }
 
-float SamplingPlan::target_pdf(int target, const Vec3& origin, const Vec3& direction) const {
-  const Target& t = scene->targets[target];
-  return t.kind == Target::Kind::Quad ? quad_area_pdf(scene->quads[t.index], origin, direction)
-                                      : sphere_cone_pdf(scene->spheres[t.index], origin, direction);
-}
-
-float SamplingPlan::light_pdf_excluding(const Vec3& origin, const Vec3& direction, int skip) const {
+float SamplingPlan::light_pdf_sum(const Vec3& origin, const Vec3& direction, const void* skip) const {
   float sum = 0.0f;
-  for (int i = 0; i < target_count; ++i)
-    if (i != skip) sum += target_pdf(i, origin, direction);
+  for (const Quad* q : quad_targets)
+    if (q != skip) sum += quad_area_pdf(*q, origin, direction);
+  for (const Sphere* sp : sphere_targets)
+    if (sp != skip) sum += sphere_cone_pdf(*sp, origin, direction);
   return sum;
 }
 
 float SamplingPlan::light_pdf(const Vec3& origin, const Vec3& direction) const {
-  return inv_target_count * light_pdf_excluding(origin, direction, -1);
+  return inv_target_count * light_pdf_sum(origin, direction, nullptr);
 }
 
 DirectionSample SamplingPlan::sample_light(const Vec3& origin, float u_target, float u1, float u2) const {
   const int chosen = std::min(static_cast<int>(u_target * static_cast<float>(target_count)), target_count - 1);
   const Target& t = scene->targets[chosen];
-  DirectionSample ds = t.kind == Target::Kind::Quad ? sample_quad_area(scene->quads[t.index], origin, u1, u2)
-                                                    : sample_sphere_cone(scene->spheres[t.index], origin, u1, u2);
   // The chosen target's pdf comes from the sampler itself (an edge sample that a
   // re-intersection might round off the target still gets its true density).
-  ds.pdf = inv_target_count * (ds.pdf + light_pdf_excluding(origin, ds.direction, chosen));
+  DirectionSample ds;
+  if (t.kind == Target::Kind::Quad) {
+    const Quad& q = scene->quads[t.index];
+    ds = sample_quad_area(q, origin, u1, u2);
+    ds.pdf = inv_target_count * (ds.pdf + light_pdf_sum(origin, ds.direction, &q));
+  } else {
+    const Sphere& sp = scene->spheres[t.index];
+    ds = sample_sphere_cone(sp, origin, u1, u2);
+    ds.pdf = inv_target_count * (ds.pdf + light_pdf_sum(origin, ds.direction, &sp));
+  }
   return ds;
 }
 
@@ -203,17 +210,17 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   if (weight[chosen] == 1.0f) return ds;  // a single technique: its own pdf is the mixture's
 
   // One-sample mixture: the density of the direction under every technique.
-  float p = weight[chosen] * ds.pdf;
-  for (int i = 0; i < kTechniqueCount; ++i) {
-    if (i == chosen || weight[i] == 0.0f) continue;
-    switch (static_cast<Technique>(i)) {
-      case Technique::Cosine: p += weight[i] * cosine_hemisphere_pdf(normal, ds.direction); break;
-      case Technique::UniformHemisphere: p += weight[i] * uniform_hemisphere_pdf(normal, ds.direction); break;
-      case Technique::UniformSphere: p += weight[i] * uniform_sphere_pdf(); break;
-      default: p += weight[i] * light_pdf(origin, ds.direction); break;
-    }
-  }
-  ds.pdf = p;
+  // The hemisphere terms are cheap and branch-free (a zero weight adds zero).
+  // The chosen technique keeps its sampler's own value, so a direction that
+  // rounding puts exactly on the horizon cannot get a zero mixture pdf.
+  const float c = dot(normal, ds.direction);
+  const float above = c > 0.0f ? 1.0f : 0.0f;
+  const int light = static_cast<int>(Technique::Light);
+  const float light_term =
+      chosen == light ? ds.pdf : (weight[light] > 0.0f ? light_pdf(origin, ds.direction) : 0.0f);
+  ds.pdf = weight[0] * (chosen == 0 ? ds.pdf : above * c * kInvPi) +
+           weight[1] * (chosen == 1 ? ds.pdf : above * kInv2Pi) +
+           weight[2] * (chosen == 2 ? ds.pdf : kInv4Pi) + weight[light] * light_term;
   return ds;
 }
 

@@ -10,6 +10,7 @@
 #include <array>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace pdflab {
 
@@ -34,13 +35,17 @@ struct Strategy {
 };
 
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
-// distribution, and the importance targets. Built once per render/pass.
+// distribution, and the importance targets. Built once per render/pass; it
+// points into the scene, which must outlive it and stay where it is.
 struct SamplingPlan {
   std::array<float, kTechniqueCount> weight{};  // normalised, sum to 1
   std::array<float, kTechniqueCount> cdf{};     // cdf[i] = weight[0] + ... + weight[i]
   const Scene* scene = nullptr;
   int target_count = 0;
   float inv_target_count = 0.0f;
+  // The targets split by kind, so evaluating the light pdf needs no per-target switch.
+  std::vector<const Quad*> quad_targets;
+  std::vector<const Sphere*> sphere_targets;
 
   // Throws InputError when the strategy needs targets the scene does not have
   // and no other technique has weight.
@@ -57,8 +62,8 @@ struct SamplingPlan {
   float light_pdf(const Vec3& origin, const Vec3& direction) const;
 
  private:
-  float light_pdf_excluding(const Vec3& origin, const Vec3& direction, int skip) const;
-  float target_pdf(int target, const Vec3& origin, const Vec3& direction) const;
+  // Sum of the per-target pdfs, leaving out the target at `skip` (or none).
+  float light_pdf_sum(const Vec3& origin, const Vec3& direction, const void* skip) const;
 };
 
 }  // namespace pdflab

@@ -22,7 +22,7 @@ inline constexpr float kInv4Pi = 0.25f * kInvPi;
 inline DirectionSample sample_cosine_hemisphere(const Onb& frame, float u1, float u2) {
   const float r = std::sqrt(u1);
   const float phi = 2.0f * kPi * u2;
-  const float z = std::sqrt(std::fmax(0.0f, 1.0f - u1));
+  const float z = std::sqrt(positive_part(1.0f - u1));
   const Vec3 local(r * std::cos(phi), r * std::sin(phi), z);
   return {frame.to_world(local), z * kInvPi};
 }
@@ -34,7 +34,7 @@ inline float cosine_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
 // Uniform hemisphere: p(w) = 1 / (2 pi) above the surface.
 inline DirectionSample sample_uniform_hemisphere(const Onb& frame, float u1, float u2) {
   const float z = 1.0f - u1;  // (0, 1]: never exactly tangent
-  const float r = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+  const float r = std::sqrt(positive_part(1.0f - z * z));
   const float phi = 2.0f * kPi * u2;
   return {frame.to_world(Vec3(r * std::cos(phi), r * std::sin(phi), z)), kInv2Pi};
 }
@@ -45,7 +45,7 @@ inline float uniform_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
 // Uniform sphere: p(w) = 1 / (4 pi). Half its samples point below the surface.
 inline DirectionSample sample_uniform_sphere(float u1, float u2) {
   const float z = 1.0f - 2.0f * u1;
-  const float r = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+  const float r = std::sqrt(positive_part(1.0f - z * z));
   const float phi = 2.0f * kPi * u2;
   return {Vec3(r * std::cos(phi), r * std::sin(phi), z), kInv4Pi};
 }
@@ -66,16 +66,16 @@ inline DirectionSample sample_quad_area(const Quad& quad, const Vec3& origin, fl
 }
 
 // Distance along a unit ray to the quad, or a negative value when it misses.
+// The tests are combined with `&` into one branch: whether a direction reaches
+// a target is unpredictable, and one mispredicted branch costs more than the math.
 inline float quad_hit_distance(const Quad& quad, const Vec3& origin, const Vec3& direction) {
   const float denom = dot(quad.normal, direction);
-  if (denom == 0.0f) return -1.0f;
-  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;
-  if (!(t > 0.0f)) return -1.0f;
+  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;  // +-inf or NaN when parallel
   const Vec3 rel = origin + direction * t - quad.q;
   const float a = dot(rel, quad.alpha_axis);
   const float b = dot(rel, quad.beta_axis);
-  if (a < 0.0f || a > 1.0f || b < 0.0f || b > 1.0f) return -1.0f;
-  return t;
+  const bool hit = (t > 0.0f) & (t < kInf) & (a >= 0.0f) & (a <= 1.0f) & (b >= 0.0f) & (b <= 1.0f);
+  return hit ? t : -1.0f;
 }
 
 inline float quad_area_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {
@@ -109,7 +109,7 @@ inline SphereCone sphere_cone(const Sphere& sphere, const Vec3& origin) {
   }
   cone.axis = to_center * (1.0f / std::sqrt(dist2));
   const float sin2_max = r2 / dist2;
-  cone.cos_max = std::sqrt(std::fmax(0.0f, 1.0f - sin2_max));
+  cone.cos_max = std::sqrt(positive_part(1.0f - sin2_max));
   cone.one_minus_cos_max = sin2_max / (1.0f + cone.cos_max);
   cone.inside = false;
   return cone;
@@ -121,7 +121,7 @@ inline DirectionSample sample_sphere_cone(const Sphere& sphere, const Vec3& orig
   if (cone.inside) return sample_uniform_sphere(u1, u2);
   const float h = u1 * cone.one_minus_cos_max;  // 1 - cos(theta), uniform in [0, 1 - cos_max)
   const float cos_theta = 1.0f - h;
-  const float sin_theta = std::sqrt(std::fmax(0.0f, h * (2.0f - h)));
+  const float sin_theta = std::sqrt(positive_part(h * (2.0f - h)));
   const float phi = 2.0f * kPi * u2;
   const Onb frame(cone.axis);
   const Vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
@@ -129,14 +129,19 @@ inline DirectionSample sample_sphere_cone(const Sphere& sphere, const Vec3& orig
 }
 
 inline float sphere_cone_pdf(const Sphere& sphere, const Vec3& origin, const Vec3& direction) {
-  const SphereCone cone = sphere_cone(sphere, origin);
-  if (cone.inside) return kInv4Pi;
-  // Inside the cone iff 1 - cos(angle to axis) <= 1 - cos_max; the left side is
-  // computed as |w - axis|^2 / 2, which keeps its precision for tiny cones.
-  const Vec3 diff = direction - cone.axis;
-  const float one_minus_cos = 0.5f * dot(diff, diff);
-  if (one_minus_cos > cone.one_minus_cos_max) return 0.0f;
-  return 1.0f / (2.0f * kPi * cone.one_minus_cos_max);
+  const Vec3 to_center = sphere.center - origin;
+  const float r2 = sphere.radius * sphere.radius;
+  const float dist2 = dot(to_center, to_center);
+  if (dist2 <= r2) return kInv4Pi;  // inside: every direction reaches the sphere
+  // Most directions miss: decide that first, cheaply and stably, by the squared
+  // distance from the centre to the ray's line (no cancellation for far spheres),
+  // in one branch (see quad_hit_distance).
+  const float along = dot(to_center, direction);
+  const Vec3 perpendicular = to_center - direction * along;
+  if (!((along > 0.0f) & (dot(perpendicular, perpendicular) <= r2))) return 0.0f;
+  const float sin2_max = r2 / dist2;
+  const float one_minus_cos_max = sin2_max / (1.0f + std::sqrt(positive_part(1.0f - sin2_max)));
+  return 1.0f / (2.0f * kPi * one_minus_cos_max);
 }
 
 }  // namespace pdflab

@@ -61,6 +61,20 @@ struct Camera {
   Ray generate_ray(float px, float py) const;  // px, py in pixel units from the top-left corner
 };
 
+// The quads again as structure-of-arrays, padded to a multiple of kQuadLanes
+// with quads that can never be hit, so the intersection loop vectorises.
+struct QuadBatch {
+  #if defined(__AVX__)
+  static constexpr int kQuadLanes = 8;
+#else
+  static constexpr int kQuadLanes = 4;
+#endif
+  int count = 0;   // real quads
+  int padded = 0;  // multiple of kQuadLanes
+  std::vector<float> nx, ny, nz, d, qx, qy, qz, ax, ay, az, bx, by, bz;
+  void build(const std::vector<struct Quad>& quads);
+};
+
 struct Scene {
   std::string name;
   Camera camera;
@@ -71,7 +85,12 @@ struct Scene {
   std::vector<Quad> quads;
   std::vector<Sphere> spheres;
   std::vector<Target> targets;
-  float scale = 1.0f;  // largest coordinate magnitude: sets the ray offset
+  float scale = 1.0f;  // largest coordinate magnitude
+  QuadBatch quad_batch;  // derived from quads by prepare()
+
+  // Builds derived data (camera basis, quad batch). Call after editing the
+  // scene; intersect() falls back to a scalar loop while the batch is stale.
+  void prepare();
 };
 
 struct Hit {

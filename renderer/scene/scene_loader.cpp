@@ -113,7 +113,6 @@ void parse_camera(const Node& node, Scene& scene) {
   if (!(length(side) > 1e-6f * length(cam.vup))) node.fail("vup is zero or parallel to the viewing direction");
   scene.max_depth = node.has("max_depth") ? node.child("max_depth").integer(1, 10000) : 50;
   scene.background = node.has("background") ? nonnegative_colour(node.child("background")) : Vec3(0.0f);
-  cam.prepare();
 }
 
 Material parse_material(const Node& node) {
@@ -263,11 +262,7 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
   if (objects.value().empty()) objects.fail("the scene has no objects");
   for (std::size_t i = 0; i < objects.value().size(); ++i) parse_object(objects.element(i), by_name, scene);
 
-  float scale = max_abs_component(scene.camera.lookfrom);
-  for (const Quad& q : scene.quads)
-    scale = std::fmax(scale, std::fmax(max_abs_component(q.q), max_abs_component(q.q + q.u + q.v)));
-  for (const Sphere& s : scene.spheres) scale = std::fmax(scale, max_abs_component(s.center) + s.radius);
-  scene.scale = scale;
+  scene.prepare();
   return scene;
 }
 
