@@ -1,5 +1,6 @@
 // pdflab: the viewer (default) and the headless commands. See INTERFACE.md / README.md.
 #include "app/assets.h"
+#include "app/bench_command.h"
 #include "app/render_command.h"
 #include "renderer/error.h"
 
@@ -55,6 +56,20 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"gamma2", "srgb"}));
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
 
+  pdflab::BenchOptions bo;
+  CLI::App* bench = app.add_subcommand("bench", "Compare strategies at equal time (or spp) against a reference");
+  bench->add_option("--scene", bo.scene, "Scene file (JSON)")->required();
+  bench->add_option("--strategies", bo.strategies, "Strategies separated by ';'")->required();
+  bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")->check(CLI::PositiveNumber);
+  bench->add_option("--spp", bo.spp, "Samples per pixel per strategy (equal samples)")->check(CLI::Range(1u, 1u << 30));
+  bench->add_option("--reference", bo.reference, "Reference image (PFM; its size sets the render size)")->required();
+  bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
+  bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
+  bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
+  bench->add_option("--seed", bo.seed, "Random seed");
+  bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  bench->add_flag("--quiet", bo.quiet, "No progress line");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -70,6 +85,7 @@ int main(int argc, char** argv) {
 
   try {
     if (render->parsed()) return pdflab::run_render(ro);
+    if (bench->parsed()) return pdflab::run_bench(bo);
 #ifdef PDFLAB_HAVE_VIEWER
     pdflab::ViewerOptions vo;
     vo.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;

@@ -101,7 +101,7 @@ std::string Strategy::to_string() const {
   int used = 0, last = 0;
   for (int i = 0; i < kTechniqueCount; ++i)
     if (weights[i] > 0.0f) ++used, last = i;
-  float total = 0.0f;
+  double total = 0.0;  // in double: weights near FLT_MAX would overflow a float sum
   for (float w : weights) total += w;
   if (used == 1) return std::string(kNames[last]);
   std::string out = "mix:";
@@ -109,7 +109,7 @@ std::string Strategy::to_string() const {
   for (int i = 0; i < kTechniqueCount; ++i) {
     if (weights[i] <= 0.0f) continue;
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(weights[i] / total));
+    std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(weights[i]) / total);
     if (!first) out += ',';
     out.append(kNames[i]).append("=").append(buf);
     first = false;

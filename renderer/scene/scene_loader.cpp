@@ -238,6 +238,20 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
     const auto colon = reason.find(": ");
     reason = colon == std::string::npos ? reason : reason.substr(colon + 2);
     throw InputError(origin + ": JSON syntax error at " + line_and_column(text, e.byte) + ": " + reason);
+  } catch (const json::exception& e) {
+    // Numbers beyond double's range (1e999) are rejected with out_of_range, not
+    // parse_error; the message quotes the number, which locates it in the text.
+    std::string reason = e.what();
+    const auto colon = reason.find("] ");
+    reason = colon == std::string::npos ? reason : reason.substr(colon + 2);
+    std::string where;
+    const auto q1 = reason.find('\'');
+    const auto q2 = q1 == std::string::npos ? std::string::npos : reason.find('\'', q1 + 1);
+    if (q2 != std::string::npos) {
+      const auto at = text.find(reason.substr(q1 + 1, q2 - q1 - 1));
+      if (at != std::string::npos) where = " at " + line_and_column(text, at + 1);
+    }
+    throw InputError(origin + ": JSON error" + where + ": " + reason);
   }
   Node root(doc, "", origin);
   root.expect_object();

@@ -1,0 +1,178 @@
+#include "app/bench_command.h"
+
+#include "renderer/error.h"
+#include "renderer/film/image_io.h"
+#include "renderer/metrics/metrics.h"
+#include "renderer/metrics/svg_plot.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <thread>
+
+namespace pdflab {
+
+namespace {
+
+struct Checkpoint {
+  std::uint32_t spp;
+  double seconds, rmse, relmse;
+};
+
+struct Result {
+  Strategy strategy;
+  std::uint32_t spp = 0;
+  double seconds = 0, rmse = 0, relmse = 0, efficiency = 0, samples_per_second = 0;
+  std::uint64_t dropped = 0;
+  std::vector<Checkpoint> curve;
+};
+
+std::vector<Strategy> parse_strategy_list(const std::string& text) {
+  std::vector<Strategy> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ';'))
+    if (item.find_first_not_of(" \t") != std::string::npos) out.push_back(Strategy::parse(item));
+  if (out.empty()) throw InputError("--strategies lists no strategy (separate them with ';')");
+  return out;
+}
+
+std::string csv_field(const std::string& s) { return "\"" + s + "\""; }
+
+void write_text(const std::string& path, const std::string& text) {
+  write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, const BenchOptions& o,
+               const std::vector<float>& reference, const std::string& progress_prefix, bool show_progress) {
+  RenderSession session(o.threads);
+  RenderSettings settings;
+  settings.scene = scene;
+  settings.strategy = strategy;
+  settings.seed = o.seed;
+  settings.target_spp = o.spp;  // 0 with --seconds: until paused
+  session.set_settings(settings);
+
+  Result r;
+  r.strategy = strategy;
+  std::vector<float> image;
+  int w = 0, h = 0;
+  std::uint64_t version = 0;
+  for (;;) {
+    const bool done = session.wait_until_done(std::chrono::milliseconds(25));
+    SessionStats st = session.stats();
+    if (session.copy_image(image, w, h, version)) {
+      const SessionStats at = session.stats();  // the image is the last complete pass
+      r.curve.push_back({at.spp, at.seconds, rmse(image, reference), relmse(image, reference)});
+    }
+    if (show_progress) {
+      const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
+      std::fprintf(stderr, "\r%s %-32s %5.1f%%  %u spp  %.1f s   ", progress_prefix.c_str(),
+                   strategy.to_string().c_str(), 100.0 * std::min(1.0, frac), st.spp, st.seconds);
+      std::fflush(stderr);
+    }
+    if (done) break;
+    if (o.seconds > 0 && st.seconds >= o.seconds) {
+      session.set_paused(true);
+      break;
+    }
+  }
+  const Film film = session.copy_film();  // waits for the pass in flight
+  const SessionStats st = session.stats();
+  const std::vector<float> final_image = film.mean_rgb();
+  r.spp = st.spp;
+  r.seconds = st.seconds;
+  r.rmse = rmse(final_image, reference);
+  r.relmse = relmse(final_image, reference);
+  r.efficiency = efficiency(r.relmse, r.seconds);
+  r.samples_per_second = st.samples_per_second;
+  r.dropped = st.dropped.total();
+  if (r.curve.empty() || r.curve.back().spp != r.spp) r.curve.push_back({r.spp, r.seconds, r.rmse, r.relmse});
+  return r;
+}
+
+}  // namespace
+
+int run_bench(const BenchOptions& o) {
+  if ((o.seconds > 0) == (o.spp > 0)) throw InputError("give exactly one of --seconds (equal time) and --spp (equal samples)");
+  if (o.seconds < 0 || !std::isfinite(o.seconds)) throw InputError("--seconds must be a positive number");
+  if (o.threads < 0) throw InputError("--threads must be >= 0");
+  check_output_path(o.csv);
+  if (!o.plot.empty()) check_output_path(o.plot);
+  if (!o.curves.empty()) check_output_path(o.curves);
+  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
+  const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
+  for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
+  int rw = 0, rh = 0;
+  const std::vector<float> reference = read_pfm(o.reference, rw, rh);
+  scene->camera.width = rw;
+  scene->camera.height = rh;
+  scene->prepare();
+
+  const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
+  std::vector<Result> results;
+  for (std::size_t i = 0; i < strategies.size(); ++i) {
+    const std::string prefix = "[" + std::to_string(i + 1) + "/" + std::to_string(strategies.size()) + "]";
+    results.push_back(run_one(scene, strategies[i], o, reference, prefix, show_progress));
+  }
+  if (show_progress) std::fputc('\n', stderr);
+
+  std::string csv = "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped\n";
+  char line[512];
+  for (const Result& r : results) {
+    std::snprintf(line, sizeof line, ",%u,%.4f,%.6g,%.6g,%.6g,%.6g,%llu\n", r.spp, r.seconds, r.rmse, r.relmse,
+                  r.efficiency, r.samples_per_second, static_cast<unsigned long long>(r.dropped));
+    csv += csv_field(r.strategy.to_string()) + line;
+  }
+  write_text(o.csv, csv);
+
+  if (!o.curves.empty()) {
+    std::string c = "strategy,spp,seconds,rmse,relmse\n";
+    for (const Result& r : results)
+      for (const Checkpoint& k : r.curve) {
+        std::snprintf(line, sizeof line, ",%u,%.4f,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse);
+        c += csv_field(r.strategy.to_string()) + line;
+      }
+    write_text(o.curves, c);
+  }
+
+  if (!o.plot.empty()) {
+    std::vector<PlotSeries> series;
+    for (const Result& r : results) {
+      PlotSeries s;
+      s.label = r.strategy.to_string() + (r.strategy.is_unbiased() ? "" : " (biased)");
+      for (const Checkpoint& k : r.curve) {
+        s.x.push_back(k.seconds);
+        s.y.push_back(k.rmse);
+      }
+      series.push_back(std::move(s));
+    }
+    PlotOptions po;
+    po.title = "RMSE against time: " + scene->name;
+    po.x_label = "seconds";
+    po.y_label = "RMSE vs reference";
+    po.guide_slope = -0.5;
+    po.guide_label = "1/sqrt(N)";
+    po.width = 900;
+    po.height = 520;
+    write_text(o.plot, loglog_svg(series, po));
+  }
+
+  // The table: efficiency relative to the first strategy says which PDF wins.
+  std::printf("%-36s %7s %8s %10s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse", "relmse",
+              "efficiency", "vs first", "Msamp/s", "dropped");
+  for (const Result& r : results) {
+    const double ratio = results[0].efficiency > 0 ? r.efficiency / results[0].efficiency : 0.0;
+    std::printf("%-36s %7u %8.2f %10.4g %10.4g %11.4g %7.2fx %9.3f %8llu%s\n", r.strategy.to_string().c_str(), r.spp,
+                r.seconds, r.rmse, r.relmse, r.efficiency, ratio, r.samples_per_second * 1e-6,
+                static_cast<unsigned long long>(r.dropped), r.strategy.is_unbiased() ? "" : "  (biased)");
+  }
+  std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e); efficiency = 1 / (relMSE * seconds)\n", kRelMseEpsilon);
+  return 0;
+}
+
+}  // namespace pdflab

@@ -1,0 +1,24 @@
+#pragma once
+#include <cstdint>
+#include <string>
+
+namespace pdflab {
+
+struct BenchOptions {
+  std::string scene;
+  std::string strategies;  // "S1;S2;..."
+  double seconds = 0.0;    // equal time per strategy (or)
+  std::uint32_t spp = 0;   // equal samples per pixel
+  std::string reference;   // PFM; its size sets the render size
+  std::string csv;
+  std::string plot;        // SVG, optional
+  std::string curves;      // CSV of every checkpoint, optional
+  std::uint64_t seed = 1;
+  int threads = 0;
+  bool quiet = false;
+};
+
+// Runs `pdflab bench`. Returns the exit status; throws InputError for bad input.
+int run_bench(const BenchOptions& options);
+
+}  // namespace pdflab

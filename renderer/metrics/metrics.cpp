@@ -1,0 +1,85 @@
+#include "renderer/metrics/metrics.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace pdflab {
+
+namespace {
+
+void check_sizes(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size() || a.empty()) throw std::invalid_argument("images differ in size or are empty");
+}
+
+// Rec. 709 luminance: the noise a viewer sees.
+double luminance(const double rgb[3]) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+}  // namespace
+
+double rmse(const std::vector<float>& image, const std::vector<float>& reference) {
+  check_sizes(image, reference);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    const double d = static_cast<double>(image[i]) - reference[i];
+    sum += d * d;
+  }
+  return std::sqrt(sum / static_cast<double>(image.size()));
+}
+
+double relmse(const std::vector<float>& image, const std::vector<float>& reference, double epsilon) {
+  check_sizes(image, reference);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    const double r = reference[i];
+    const double d = static_cast<double>(image[i]) - r;
+    sum += d * d / (r * r + epsilon);
+  }
+  return sum / static_cast<double>(image.size());
+}
+
+double efficiency(double relmse_value, double seconds) {
+  if (!(relmse_value > 0.0) || !(seconds > 0.0)) return 0.0;
+  return 1.0 / (relmse_value * seconds);
+}
+
+double mean_relative_standard_error(const Film& film, double epsilon) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
+    if (film.count(p) < 2) continue;
+    double m[3], v[3];
+    film.mean(p, m);
+    film.variance_of_mean(p, v);
+    sum += std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+double estimated_relmse(const Film& film, double epsilon) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
+    if (film.count(p) < 2) continue;
+    double m[3], v[3];
+    film.mean(p, m);
+    film.variance_of_mean(p, v);
+    for (int c = 0; c < 3; ++c) sum += v[c] / (m[c] * m[c] + epsilon);
+    n += 3;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+std::vector<float> relative_standard_error_map(const Film& film, double epsilon) {
+  std::vector<float> out(film.pixel_count(), 0.0f);
+  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
+    if (film.count(p) < 2) continue;
+    double m[3], v[3];
+    film.mean(p, m);
+    film.variance_of_mean(p, v);
+    out[p] = static_cast<float>(std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon));
+  }
+  return out;
+}
+
+}  // namespace pdflab

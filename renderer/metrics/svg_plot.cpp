@@ -1,0 +1,126 @@
+#include "renderer/metrics/svg_plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace pdflab {
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+constexpr const char* kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                                    "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
+
+}  // namespace
+
+std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions& o) {
+  double x0 = std::numeric_limits<double>::infinity(), x1 = 0.0, y0 = x0, y1 = 0.0;
+  for (const auto& s : series)
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
+      y0 = std::min(y0, s.y[i]), y1 = std::max(y1, s.y[i]);
+    }
+  if (!(x1 > 0.0)) x0 = 1.0, x1 = 10.0, y0 = 1.0, y1 = 10.0;
+  // Whole decades, so the grid lines fall on powers of ten.
+  const double lx0 = std::floor(std::log10(x0)), lx1 = std::max(lx0 + 1.0, std::ceil(std::log10(x1)));
+  const double ly0 = std::floor(std::log10(y0)), ly1 = std::max(ly0 + 1.0, std::ceil(std::log10(y1)));
+
+  const double left = 80, right = 200, top = 40, bottom = 60;
+  const double pw = o.width - left - right, ph = o.height - top - bottom;
+  auto px = [&](double x) { return left + (std::log10(x) - lx0) / (lx1 - lx0) * pw; };
+  auto py = [&](double y) { return top + (ly1 - std::log10(y)) / (ly1 - ly0) * ph; };
+
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
+                    std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+         escape(o.title) + "</text>\n";
+  for (double d = lx0; d <= lx1 + 1e-9; d += 1.0) {
+    const double x = left + (d - lx0) / (lx1 - lx0) * pw;
+    svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
+           fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">1e" +
+           fmt("%.0f", d) + "</text>\n";
+  }
+  for (double d = ly0; d <= ly1 + 1e-9; d += 1.0) {
+    const double y = top + (ly1 - d) / (ly1 - ly0) * ph;
+    svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
+           "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">1e" +
+           fmt("%.0f", d) + "</text>\n";
+  }
+  svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
+         "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
+  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"" + fmt("%.1f", o.height - 15.0) +
+         "\" text-anchor=\"middle\">" + escape(o.x_label) + "</text>\n";
+  svg += "<text transform=\"translate(20," + fmt("%.1f", top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
+         escape(o.y_label) + "</text>\n";
+
+  double legend_y = top + 10;
+  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) {
+    svg += "<line x1=\"" + fmt("%.1f", left + pw + 15) + "\" y1=\"" + fmt("%.1f", legend_y) + "\" x2=\"" +
+           fmt("%.1f", left + pw + 40) + "\" y2=\"" + fmt("%.1f", legend_y) + "\" stroke=\"" + colour +
+           "\" stroke-width=\"2\"" + (dashed ? " stroke-dasharray=\"5,4\"" : "") + "/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left + pw + 45) + "\" y=\"" + fmt("%.1f", legend_y + 4) + "\">" + escape(label) +
+           "</text>\n";
+    legend_y += 20;
+  };
+
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const auto& s = series[k];
+    const std::string colour = kColours[k % (sizeof kColours / sizeof kColours[0])];
+    std::string points;
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      points += fmt("%.1f", px(s.x[i])) + "," + fmt("%.1f", py(s.y[i])) + " ";
+    }
+    svg += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\" points=\"" + points + "\"/>\n";
+    legend(colour, s.label, false);
+  }
+
+  if (o.guide_slope != 0.0 && !series.empty() && !series[0].x.empty()) {
+    // Through the first series' first valid point, across the whole x range.
+    double gx = 0.0, gy = 0.0;
+    for (std::size_t i = 0; i < series[0].x.size(); ++i)
+      if (series[0].x[i] > 0.0 && series[0].y[i] > 0.0) {
+        gx = series[0].x[i], gy = series[0].y[i];
+        break;
+      }
+    if (gx > 0.0) {
+      const double xa = std::pow(10.0, lx0), xb = std::pow(10.0, lx1);
+      double ya = gy * std::pow(xa / gx, o.guide_slope), yb = gy * std::pow(xb / gx, o.guide_slope);
+      svg += "<clipPath id=\"plot\"><rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" +
+             fmt("%.1f", pw) + "\" height=\"" + fmt("%.1f", ph) + "\"/></clipPath>\n";
+      svg += "<line clip-path=\"url(#plot)\" x1=\"" + fmt("%.1f", px(xa)) + "\" y1=\"" + fmt("%.1f", py(ya)) +
+             "\" x2=\"" + fmt("%.1f", px(xb)) + "\" y2=\"" + fmt("%.1f", py(yb)) +
+             "\" stroke=\"#555\" stroke-dasharray=\"5,4\"/>\n";
+      legend("#555", o.guide_label, true);
+    }
+  }
+  svg += "</svg>\n";
+  return svg;
+}
+
+}  // namespace pdflab
