@@ -1,0 +1,305 @@
+// The `pdflab render` contract from INTERFACE.md, checked on the real binary:
+// each class of bad input exits 2 with one message naming the problem and
+// writes nothing; a small render writes the image, the stats JSON and a summary.
+#include "renderer/film/image_io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <regex>
+#include <string>
+#include <vector>
+
+extern char** environ;
+
+namespace pdflab {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json";
+const std::string kBadInput = std::string(PDFLAB_SOURCE_DIR) + "/tests/bad_input/";
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct RunResult {
+  bool exited = false;  // false: killed by a signal
+  int status = -1;      // exit status when exited
+  std::string out, err;
+};
+
+// Each test gets an empty working folder (the child's cwd and where outputs
+// go) and a separate folder for the captured streams, so that "nothing was
+// written" can be checked by listing the working folder.
+class RenderCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "pdflab-cli-XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    root_ = pattern;
+    fs::create_directory(work());
+    fs::create_directory(root_ / "io");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+
+  fs::path work() const { return root_ / "work"; }
+  std::string in_work(const std::string& name) const { return (work() / name).string(); }
+
+  std::vector<std::string> work_entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(work()))
+      names.push_back(fs::relative(e.path(), work()).string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  // Runs the binary directly (no shell) with stdin from /dev/null.
+  RunResult run(const std::vector<std::string>& args) const {
+    const std::string out_path = (root_ / "io" / "stdout").string();
+    const std::string err_path = (root_ / "io" / "stderr").string();
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addchdir_np(&actions, work().c_str());
+
+    std::vector<std::string> storage;
+    storage.reserve(args.size() + 1);
+    storage.emplace_back(PDFLAB_BINARY);
+    storage.insert(storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& s : storage) argv.push_back(s.data());
+    argv.push_back(nullptr);
+
+    RunResult r;
+    pid_t pid = 0;
+    const int rc = ::posix_spawn(&pid, PDFLAB_BINARY, &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+      ADD_FAILURE() << "posix_spawn(" << PDFLAB_BINARY << ") failed: " << std::strerror(rc);
+      return r;
+    }
+    int status = 0;
+    if (::waitpid(pid, &status, 0) != pid) {
+      ADD_FAILURE() << "waitpid failed";
+      return r;
+    }
+    r.exited = WIFEXITED(status);
+    r.status = r.exited ? WEXITSTATUS(status) : -1;
+    r.out = read_text(out_path);
+    r.err = read_text(err_path);
+    return r;
+  }
+
+  // A render command line that is valid except for what `overrides` changes.
+  std::vector<std::string> render_args(std::initializer_list<std::string> extra = {}) const {
+    std::vector<std::string> a = {"render",  "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5",
+                                  "--spp",   "4",       "--out",    in_work("image.png"),
+                                  "--width", "16",      "--height", "16", "--threads", "2"};
+    a.insert(a.end(), extra);
+    return a;
+  }
+
+  static std::vector<std::string> replace(std::vector<std::string> args, const std::string& flag,
+                                          const std::string& value) {
+    const auto it = std::find(args.begin(), args.end(), flag);
+    if (it == args.end() || it + 1 == args.end()) {
+      ADD_FAILURE() << "no " << flag << " to replace";
+      return args;
+    }
+    *(it + 1) = value;
+    return args;
+  }
+
+  // Bad input: status 2, a message on stderr that contains `needle`, no trace
+  // of a crash or an internal error, and nothing written to the working folder.
+  void expect_bad_input(const std::vector<std::string>& args, const std::string& needle) const {
+    std::string line;
+    for (const auto& a : args) line += " " + a;
+    SCOPED_TRACE("pdflab" + line);
+    const RunResult r = run(args);
+    ASSERT_TRUE(r.exited) << "killed by a signal; stderr:\n" << r.err;
+    EXPECT_EQ(r.status, 2) << "stderr:\n" << r.err;
+    EXPECT_EQ(r.err.rfind("pdflab: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr lacks '" << needle << "':\n" << r.err;
+    for (const char* crash : {"internal error", "terminate called", "what()", "Aborted", "core dumped", "Segmentation"})
+      EXPECT_EQ(r.err.find(crash), std::string::npos) << "stderr shows '" << crash << "':\n" << r.err;
+    EXPECT_LE(std::count(r.err.begin(), r.err.end(), '\n'), 2) << "more than a short message:\n" << r.err;
+    EXPECT_EQ(r.out, "") << "bad input printed a result";
+    EXPECT_TRUE(work_entries().empty()) << "files were written: " << ::testing::PrintToString(work_entries());
+  }
+
+  fs::path root_;
+};
+
+TEST_F(RenderCommand, ValidBaseCommandSucceeds) {
+  // Every bad-input test changes one thing in this command: it must work as is.
+  const RunResult r = run(render_args());
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(work_entries(), std::vector<std::string>{"image.png"});
+}
+
+TEST_F(RenderCommand, UnknownFlag) { expect_bad_input(render_args({"--bogus"}), "--bogus"); }
+
+TEST_F(RenderCommand, MissingRequiredOption) {
+  std::vector<std::string> args = render_args();
+  args.erase(std::find(args.begin(), args.end(), "--out"), std::find(args.begin(), args.end(), "--width"));
+  expect_bad_input(args, "--out");
+}
+
+TEST_F(RenderCommand, UnknownStrategy) {
+  expect_bad_input(replace(render_args(), "--strategy", "phong"), "unknown strategy 'phong'");
+  expect_bad_input(replace(render_args(), "--strategy", "mix:cosine=1,cosine=1"), "appears twice");
+  expect_bad_input(replace(render_args(), "--strategy", "mix:cosine=-1,light=1"), "weight '-1'");
+}
+
+TEST_F(RenderCommand, StrategyNeedsTargetsTheSceneLacks) {
+  std::vector<std::string> args = replace(render_args(), "--strategy", "light");
+  expect_bad_input(replace(args, "--scene", kBadInput + "no_targets.json"), "has none");
+}
+
+TEST_F(RenderCommand, BadNumbers) {
+  expect_bad_input(replace(render_args(), "--spp", "abc"), "--spp");
+  expect_bad_input(replace(render_args(), "--spp", "-3"), "--spp");
+  expect_bad_input(replace(render_args(), "--spp", "0"), "--spp");
+  expect_bad_input(replace(render_args(), "--spp", "4x"), "--spp");
+  expect_bad_input(replace(render_args(), "--width", "0"), "--width");
+  expect_bad_input(replace(render_args(), "--height", "16385"), "--height");
+  expect_bad_input(replace(render_args(), "--threads", "-1"), "--threads");
+  expect_bad_input(render_args({"--seed", "seven"}), "--seed");
+}
+
+TEST_F(RenderCommand, MissingSceneFile) {
+  const std::string missing = in_work("nope.json");
+  expect_bad_input(replace(render_args(), "--scene", missing), "cannot read scene '" + missing + "'");
+}
+
+TEST_F(RenderCommand, SceneWithSyntaxError) {
+  expect_bad_input(replace(render_args(), "--scene", kBadInput + "syntax_error.json"), "syntax_error.json: JSON syntax error at line 5");
+}
+
+TEST_F(RenderCommand, SceneThatFailsValidation) {
+  expect_bad_input(replace(render_args(), "--scene", kBadInput + "negative_radius.json"), "objects[1].radius");
+}
+
+TEST_F(RenderCommand, SceneWithOverflowingNumber) {
+  // 1e999 is the closest JSON gets to an infinite number: bad input, not an internal error.
+  expect_bad_input(replace(render_args(), "--scene", kBadInput + "overflow_number.json"), "1e999");
+}
+
+TEST_F(RenderCommand, UnknownOutputExtension) {
+  expect_bad_input(replace(render_args(), "--out", in_work("image.jpg")), "unknown image format '.jpg'");
+  expect_bad_input(replace(render_args(), "--out", in_work("image")), "unknown image format");
+}
+
+TEST_F(RenderCommand, OutputFolderMissing) {
+  expect_bad_input(replace(render_args(), "--out", in_work("missing/image.png")), "does not exist");
+  expect_bad_input(render_args({"--stats-json", in_work("missing/stats.json")}), "does not exist");
+}
+
+// ---- Successful renders ---------------------------------------------------------
+
+std::vector<std::string> small_render(const std::string& out, std::initializer_list<std::string> extra = {}) {
+  std::vector<std::string> a = {"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5",
+                                "--spp", "4", "--out", out, "--width", "32", "--height", "32", "--threads", "2"};
+  a.insert(a.end(), extra);
+  return a;
+}
+
+TEST_F(RenderCommand, RendersPfmAndStatsJson) {
+  const RunResult r = run(small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json"), "--seed", "5"}));
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(work_entries(), (std::vector<std::string>{"image.pfm", "stats.json"}));
+
+  int w = 0, h = 0;
+  const std::vector<float> rgb = read_pfm(in_work("image.pfm"), w, h);
+  EXPECT_EQ(w, 32);
+  EXPECT_EQ(h, 32);
+  double total = 0.0;
+  for (float v : rgb) {
+    ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+    total += v;
+  }
+  EXPECT_GT(total / static_cast<double>(rgb.size()), 0.01) << "the Cornell box rendered black";
+
+  const nlohmann::json stats = nlohmann::json::parse(read_text(work() / "stats.json"));
+  EXPECT_EQ(stats.at("spp").get<int>(), 4);
+  EXPECT_EQ(stats.at("width").get<int>(), 32);
+  EXPECT_EQ(stats.at("height").get<int>(), 32);
+  EXPECT_EQ(stats.at("seed").get<int>(), 5);
+  EXPECT_EQ(stats.at("threads").get<int>(), 2);
+  EXPECT_EQ(stats.at("strategy").get<std::string>(), "mix:cosine=0.5,light=0.5");
+  EXPECT_EQ(stats.at("samples").get<std::uint64_t>(), 32u * 32u * 4u);
+  const double seconds = stats.at("seconds").get<double>();
+  const double rate = stats.at("samples_per_second").get<double>();
+  EXPECT_GT(seconds, 0.0);
+  EXPECT_NEAR(rate, 32.0 * 32.0 * 4.0 / seconds, 1e-6 * rate);
+  const auto& dropped = stats.at("dropped");
+  std::uint64_t sum = 0;
+  for (const char* reason : {"pdf_zero", "pdf_not_finite", "radiance_not_finite"}) {
+    ASSERT_TRUE(dropped.contains(reason)) << reason;
+    sum += dropped.at(reason).get<std::uint64_t>();
+  }
+  EXPECT_EQ(dropped.at("total").get<std::uint64_t>(), sum);
+  EXPECT_LE(sum, 32u * 32u * 4u);
+
+  // The one-line summary carries the same numbers.
+  static const std::regex summary(R"(^4 spp, 32x32, [0-9.]+ s, [0-9.]+ M samples/s, 2 threads, [0-9]+ samples dropped.*\n$)");
+  EXPECT_TRUE(std::regex_search(r.out, summary)) << "stdout: " << r.out;
+  EXPECT_NE(r.out.find(", " + std::to_string(sum) + " samples dropped"), std::string::npos) << r.out;
+}
+
+TEST_F(RenderCommand, RendersPng) {
+  const RunResult r = run(small_render(in_work("image.png")));
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(work_entries(), std::vector<std::string>{"image.png"});
+  const std::string png = read_text(work() / "image.png");
+  ASSERT_GT(png.size(), 24u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  EXPECT_EQ(png.substr(12, 4), "IHDR");
+  const auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(png[at + i]);
+    return v;
+  };
+  EXPECT_EQ(u32(16), 32u);
+  EXPECT_EQ(u32(20), 32u);
+  EXPECT_NE(r.out.find("4 spp"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("M samples/s"), std::string::npos) << r.out;
+}
+
+TEST_F(RenderCommand, RendersHdr) {
+  const RunResult r = run(small_render(in_work("image.hdr")));
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(work_entries(), std::vector<std::string>{"image.hdr"});
+  const std::string hdr = read_text(work() / "image.hdr");
+  EXPECT_EQ(hdr.rfind("#?RADIANCE", 0), 0u);
+  EXPECT_NE(hdr.find("-Y 32 +X 32"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pdflab

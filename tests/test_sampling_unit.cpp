@@ -1,0 +1,381 @@
+// Deterministic unit checks of the sampling building blocks: the ONB, the
+// sphere cone and quad area pdfs at hand-checkable points, strategy parsing,
+// and the mixture's technique selection. Distribution shape is the chi-square
+// suite's job; here every expectation is a number we can derive by hand.
+#include "renderer/error.h"
+#include "renderer/sampling/onb.h"
+#include "renderer/sampling/rng.h"
+#include "renderer/sampling/strategy.h"
+#include "renderer/sampling/techniques.h"
+#include "renderer/scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+namespace {
+
+// ---- ONB ------------------------------------------------------------------------
+
+void expect_right_handed_orthonormal(const Vec3& n) {
+  const Onb f(n);
+  constexpr float kTol = 2e-6f;
+  EXPECT_NEAR(length(f.s), 1.0f, kTol) << "n=(" << n.x << "," << n.y << "," << n.z << ")";
+  EXPECT_NEAR(length(f.t), 1.0f, kTol) << "n=(" << n.x << "," << n.y << "," << n.z << ")";
+  EXPECT_NEAR(dot(f.s, f.t), 0.0f, kTol) << "n=(" << n.x << "," << n.y << "," << n.z << ")";
+  EXPECT_NEAR(dot(f.s, n), 0.0f, kTol) << "n=(" << n.x << "," << n.y << "," << n.z << ")";
+  EXPECT_NEAR(dot(f.t, n), 0.0f, kTol) << "n=(" << n.x << "," << n.y << "," << n.z << ")";
+  // Right-handed: s x t is n itself, not -n.
+  const Vec3 c = cross(f.s, f.t);
+  EXPECT_NEAR(c.x, n.x, kTol);
+  EXPECT_NEAR(c.y, n.y, kTol);
+  EXPECT_NEAR(c.z, n.z, kTol);
+  // The local frame's +z is the normal, and to_local undoes to_world.
+  const Vec3 up = f.to_world(Vec3(0.0f, 0.0f, 1.0f));
+  EXPECT_NEAR(length(up - n), 0.0f, kTol);
+  const Vec3 v(0.3f, -0.5f, 0.8f);
+  EXPECT_NEAR(length(f.to_local(f.to_world(v)) - v), 0.0f, 4e-6f);
+}
+
+TEST(Onb, AxisNormals) {
+  for (const Vec3& n : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1),
+                        Vec3(0, 0, -1)})
+    expect_right_handed_orthonormal(n);
+  // The branch in the construction keys on the sign bit of z: -0 must work too.
+  expect_right_handed_orthonormal(Vec3(1.0f, 0.0f, -0.0f));
+  expect_right_handed_orthonormal(Vec3(0.0f, -1.0f, -0.0f));
+}
+
+TEST(Onb, NearlyAxisNormals) {
+  for (const Vec3& n : {Vec3(1e-7f, 0, -1), Vec3(0, 1e-7f, -1), Vec3(-1e-7f, -1e-7f, -1), Vec3(1e-7f, 0, 1),
+                        Vec3(1e-4f, 0, -1), Vec3(0, 1e-3f, -1), Vec3(1, 1e-7f, 1e-7f), Vec3(1e-7f, -1, -1e-7f),
+                        Vec3(-1, 0, -1e-7f)})
+    expect_right_handed_orthonormal(normalize(n));
+}
+
+TEST(Onb, RandomNormals) {
+  Rng rng(12345, 678);
+  for (int i = 0; i < 2000; ++i) {
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    expect_right_handed_orthonormal(sample_uniform_sphere(u1, u2).direction);
+  }
+}
+
+// ---- Sphere cone ------------------------------------------------------------------
+
+// 1 - cos(theta_max) in double, from the same float inputs the renderer sees.
+double reference_one_minus_cos(const Sphere& s, const Vec3& origin) {
+  const double dx = double(s.center.x) - origin.x, dy = double(s.center.y) - origin.y,
+               dz = double(s.center.z) - origin.z;
+  const double d2 = dx * dx + dy * dy + dz * dz;
+  const double sin2 = double(s.radius) * s.radius / d2;
+  return sin2 / (1.0 + std::sqrt(1.0 - sin2));
+}
+
+TEST(SphereCone, SmallAndFarSpheresKeepPrecision) {
+  const Vec3 dir = normalize(Vec3(1.0f, 2.0f, 3.0f));
+  const struct {
+    float radius, distance;
+  } cases[] = {{1.0f, 1e3f}, {1.0f, 1e6f}, {1e-3f, 10.0f}, {1.0f, 1.5f}, {2.0f, 1e5f}};
+  for (const auto& c : cases) {
+    const Vec3 origin(0.5f, -0.25f, 1.0f);
+    const Sphere sphere{origin + dir * c.distance, c.radius, 0};
+    const SphereCone cone = sphere_cone(sphere, origin);
+    const double expected = reference_one_minus_cos(sphere, origin);
+    ASSERT_FALSE(cone.inside);
+    EXPECT_LT(std::fabs(cone.one_minus_cos_max - expected) / expected, 1e-4)
+        << "r=" << c.radius << " d=" << c.distance << " got " << cone.one_minus_cos_max << " want " << expected;
+
+    const Vec3 to_centre = normalize(sphere.center - origin);
+    const float p = sphere_cone_pdf(sphere, origin, to_centre);
+    EXPECT_TRUE(std::isfinite(p) && p > 0.0f) << "pdf towards the centre: " << p;
+    EXPECT_LT(std::fabs(p - 1.0 / (2.0 * std::numbers::pi * expected)) * (2.0 * std::numbers::pi * expected), 1e-4);
+
+    // A direction far outside the cone has density zero.
+    EXPECT_EQ(sphere_cone_pdf(sphere, origin, -to_centre), 0.0f);
+  }
+}
+
+TEST(SphereCone, SamplesStayInsideTheConeAndAgreeWithThePdf) {
+  const Vec3 origin(0.0f);
+  const Sphere sphere{Vec3(0.0f, 0.0f, 1e3f), 1.0f, 0};
+  Rng rng(7, 9);
+  for (int i = 0; i < 5000; ++i) {
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const DirectionSample ds = sample_sphere_cone(sphere, origin, u1, u2);
+    ASSERT_TRUE(std::isfinite(ds.pdf) && ds.pdf > 0.0f);
+    EXPECT_NEAR(length(ds.direction), 1.0f, 1e-5f);
+    const float p = sphere_cone_pdf(sphere, origin, ds.direction);
+    EXPECT_NEAR(p / ds.pdf, 1.0f, 1e-4f) << "u=(" << u1 << "," << u2 << ")";
+  }
+}
+
+// The mixture and MIS evaluate sphere_cone_pdf on directions other techniques
+// drew; if it says 0 for directions the cone sampler itself produces, the
+// light's share of the estimator loses those paths. A naive 1 - dot(w, axis)
+// in float cannot resolve a cone narrower than ~1e-4 rad at all, so this fails
+// wholesale if the evaluator loses its cancellation-free form. Only a thin
+// outer ring may be lost to the ~6e-8 rounding of a float direction.
+// (At 1e6 the cone is 1e-6 wide and that ring is a few percent: a limit of
+// float directions, not checked here.)
+TEST(SphereCone, FarSphereSamplesKeepTheirDensity) {
+  const Vec3 origin(0.0f);
+  for (float distance : {1e3f, 1e4f, 1e5f}) {
+    const Sphere sphere{normalize(Vec3(1.0f, 2.0f, 3.0f)) * distance, 1.0f, 0};
+    Rng rng(7, 9);
+    constexpr int kSamples = 20000;
+    int rejected = 0;
+    for (int i = 0; i < kSamples; ++i) {
+      const float u1 = rng.uniform(), u2 = rng.uniform();
+      const DirectionSample ds = sample_sphere_cone(sphere, origin, u1, u2);
+      ASSERT_TRUE(std::isfinite(ds.pdf) && ds.pdf > 0.0f);
+      if (sphere_cone_pdf(sphere, origin, ds.direction) == 0.0f) ++rejected;
+    }
+    EXPECT_LT(rejected, kSamples / 100) << "distance " << distance << ": " << rejected << " of " << kSamples
+                                         << " cone samples evaluate to pdf 0";
+  }
+}
+
+TEST(SphereCone, InsideTheSphereIsUniform) {
+  const Sphere sphere{Vec3(1.0f, 2.0f, 3.0f), 2.0f, 0};
+  const float expected = 1.0f / (4.0f * std::numbers::pi_v<float>);
+  for (const Vec3& origin : {Vec3(1.0f, 2.0f, 3.0f), Vec3(1.5f, 2.0f, 3.5f), Vec3(1.0f, 0.0f, 3.0f)}) {
+    EXPECT_TRUE(sphere_cone(sphere, origin).inside);
+    for (const Vec3& d : {Vec3(0, 0, 1), Vec3(0, -1, 0), normalize(Vec3(1, -2, 0.5f))})
+      EXPECT_FLOAT_EQ(sphere_cone_pdf(sphere, origin, d), expected);
+    EXPECT_FLOAT_EQ(sample_sphere_cone(sphere, origin, 0.3f, 0.6f).pdf, expected);
+  }
+}
+
+// ---- Quad area pdf ------------------------------------------------------------------
+
+// A 2 x 2 square in the plane y = 10 centred above the origin; area 4.
+Quad ceiling_square() { return make_quad(Vec3(-1, 10, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), 0); }
+
+TEST(QuadAreaPdf, HandComputedCases) {
+  const Quad q = ceiling_square();
+  const Vec3 origin(0.0f);
+  // Straight up: d = 10, cos = 1: 100 / 4.
+  EXPECT_FLOAT_EQ(quad_area_pdf(q, origin, Vec3(0, 1, 0)), 25.0f);
+  // Towards (0.5, 10, 0.5): d^2 = 100.5, cos = 10 / sqrt(100.5): d^2 / (cos A) = 100.5^1.5 / 40.
+  const Vec3 d = normalize(Vec3(0.5f, 10.0f, 0.5f));
+  EXPECT_NEAR(quad_area_pdf(q, origin, d), std::pow(100.5, 1.5) / 40.0, 1e-3);
+  // The density is the same from behind the quad (|cos|).
+  EXPECT_FLOAT_EQ(quad_area_pdf(q, Vec3(0, 20, 0), Vec3(0, -1, 0)), 25.0f);
+  // The sampler reports the same density as the evaluator at the sampled point.
+  const DirectionSample ds = sample_quad_area(q, origin, 0.5f, 0.5f);
+  EXPECT_NEAR(ds.direction.y, 1.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(ds.pdf, 25.0f);
+  const DirectionSample corner = sample_quad_area(q, origin, 0.75f, 0.75f);  // the point (0.5, 10, 0.5)
+  EXPECT_NEAR(corner.pdf, std::pow(100.5, 1.5) / 40.0, 1e-3);
+}
+
+TEST(QuadAreaPdf, MissingRaysHaveZeroDensity) {
+  const Quad q = ceiling_square();
+  const Vec3 origin(0.0f);
+  EXPECT_EQ(quad_area_pdf(q, origin, Vec3(0, -1, 0)), 0.0f);              // pointing away
+  EXPECT_EQ(quad_area_pdf(q, origin, Vec3(1, 0, 0)), 0.0f);               // parallel to the plane
+  EXPECT_EQ(quad_area_pdf(q, origin, normalize(Vec3(5, 10, 0))), 0.0f);   // beside the square
+  EXPECT_EQ(quad_area_pdf(q, origin, normalize(Vec3(0, 10, -1.5f))), 0.0f);
+}
+
+// ---- Strategy parsing -----------------------------------------------------------------
+
+std::string parse_error(const std::string& text) {
+  try {
+    (void)Strategy::parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "'" << text << "' parsed";
+  return {};
+}
+
+float weight_of(const Strategy& s, Technique t) { return s.weights[static_cast<int>(t)]; }
+
+TEST(StrategyParse, SingleTechniques) {
+  const struct {
+    const char* text;
+    Technique t;
+  } cases[] = {{"cosine", Technique::Cosine},
+               {"uniform-hemisphere", Technique::UniformHemisphere},
+               {"uniform-sphere", Technique::UniformSphere},
+               {"light", Technique::Light},
+               {"  light ", Technique::Light}};
+  for (const auto& c : cases) {
+    const Strategy s = Strategy::parse(c.text);
+    for (int i = 0; i < kTechniqueCount; ++i)
+      EXPECT_EQ(s.weights[i], i == static_cast<int>(c.t) ? 1.0f : 0.0f) << c.text << " technique " << i;
+  }
+}
+
+TEST(StrategyParse, Mixtures) {
+  Strategy s = Strategy::parse("mix:cosine=0.5,light=0.5");
+  EXPECT_EQ(weight_of(s, Technique::Cosine), 0.5f);
+  EXPECT_EQ(weight_of(s, Technique::Light), 0.5f);
+  EXPECT_EQ(weight_of(s, Technique::UniformSphere), 0.0f);
+
+  s = Strategy::parse("mix:cosine=1,light=0");
+  EXPECT_EQ(weight_of(s, Technique::Cosine), 1.0f);
+  EXPECT_EQ(weight_of(s, Technique::Light), 0.0f);
+
+  s = Strategy::parse(" mix: cosine = 0.25 ,  light=0.75 , uniform-sphere = 0 ");
+  EXPECT_EQ(weight_of(s, Technique::Cosine), 0.25f);
+  EXPECT_EQ(weight_of(s, Technique::Light), 0.75f);
+  EXPECT_EQ(weight_of(s, Technique::UniformSphere), 0.0f);
+
+  s = Strategy::parse("mix:uniform-hemisphere=2,uniform-sphere=6");
+  EXPECT_EQ(weight_of(s, Technique::UniformHemisphere), 2.0f);
+  EXPECT_EQ(weight_of(s, Technique::UniformSphere), 6.0f);
+}
+
+void expect_rejected(const std::string& text, std::initializer_list<const char*> needles) {
+  const std::string message = parse_error(text);
+  for (const char* needle : needles)
+    EXPECT_NE(message.find(needle), std::string::npos) << "for '" << text << "': '" << message << "' lacks '"
+                                                       << needle << "'";
+}
+
+TEST(StrategyParse, Rejections) {
+  expect_rejected("phong", {"unknown strategy 'phong'", "cosine"});
+  expect_rejected("Cosine", {"unknown strategy"});
+  expect_rejected("mix:cosine=0.5,glossy=0.5", {"unknown technique 'glossy'"});
+  expect_rejected("mix:cosine=0.5,cosine=0.5", {"'cosine' appears twice"});
+  expect_rejected("mix:cosine=-1,light=1", {"weight '-1'"});
+  expect_rejected("mix:cosine=nan,light=1", {"weight 'nan'"});
+  expect_rejected("mix:cosine=inf,light=1", {"weight 'inf'"});
+  expect_rejected("mix:cosine=,light=1", {"weight ''"});
+  expect_rejected("mix:cosine=0.5x,light=1", {"weight '0.5x'"});
+  expect_rejected("mix:cosine=1e60,light=1", {"weight '1e60'"});  // not a finite float
+  expect_rejected("mix:cosine=0,light=0", {"all weights are zero"});
+  expect_rejected("mix:", {"no technique"});
+  expect_rejected("mix:cosine", {"TECHNIQUE=WEIGHT"});
+  expect_rejected("mix:cosine=1,", {"TECHNIQUE=WEIGHT"});
+  expect_rejected("", {"empty strategy"});
+  expect_rejected("   ", {"empty strategy"});
+  expect_rejected("light-sa", {"not available"});
+}
+
+TEST(StrategyParse, ToStringRoundTrips) {
+  for (const char* text : {"cosine", "uniform-hemisphere", "uniform-sphere", "light", "mix:cosine=0.5,light=0.5",
+                           "mix:cosine=1,light=3", "mix:cosine=1,uniform-hemisphere=1,uniform-sphere=1,light=1",
+                           "mix:cosine=1,light=0", "mix:light=0.001,cosine=0.999", "mix:cosine=1e-30,light=1",
+                           // Large but finite float weights are accepted by parse, so they must print too.
+                           "mix:cosine=3e38,light=3e38"}) {
+    const Strategy s = Strategy::parse(text);
+    const std::string canonical = s.to_string();
+    Strategy back;
+    ASSERT_NO_THROW(back = Strategy::parse(canonical)) << text << " -> '" << canonical << "'";
+    EXPECT_EQ(back.to_string(), canonical) << text;
+    // Same normalised weights: the canonical form is a fixed point of parse/print.
+    double total_a = 0.0, total_b = 0.0;
+    for (int i = 0; i < kTechniqueCount; ++i) total_a += s.weights[i], total_b += back.weights[i];
+    for (int i = 0; i < kTechniqueCount; ++i)
+      EXPECT_NEAR(s.weights[i] / total_a, back.weights[i] / total_b, 1e-6) << text << " technique " << i;
+  }
+  EXPECT_EQ(Strategy::parse("mix:cosine=1,light=0").to_string(), "cosine");
+  EXPECT_EQ(Strategy::parse("mix:cosine=1,light=3").to_string(), "mix:cosine=0.25,light=0.75");
+}
+
+// ---- SamplingPlan -------------------------------------------------------------------------
+
+// A shading point at the origin (normal +y) and one small importance target: a
+// light quad below it (y = -5) when `below`, else above it (y = +5).
+Scene one_target_scene(bool below) {
+  Scene scene;
+  scene.name = "one target";
+  Material lamp;
+  lamp.type = MaterialType::DiffuseLight;
+  lamp.emit = Vec3(1.0f);
+  scene.materials.push_back(lamp);
+  scene.material_names.push_back("lamp");
+  const float y = below ? -5.0f : 5.0f;
+  scene.quads.push_back(make_quad(Vec3(-0.5f, y, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));
+  scene.targets.push_back({Target::Kind::Quad, 0});
+  return scene;
+}
+
+TEST(SamplingPlan, NormalisesWeights) {
+  const Scene scene = one_target_scene(false);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=1,light=3"), scene);
+  EXPECT_FLOAT_EQ(plan.weight[static_cast<int>(Technique::Cosine)], 0.25f);
+  EXPECT_FLOAT_EQ(plan.weight[static_cast<int>(Technique::Light)], 0.75f);
+  EXPECT_EQ(plan.weight[static_cast<int>(Technique::UniformSphere)], 0.0f);
+  float sum = 0.0f;
+  for (float w : plan.weight) sum += w;
+  EXPECT_FLOAT_EQ(sum, 1.0f);
+  EXPECT_EQ(plan.cdf[kTechniqueCount - 1], 1.0f);
+}
+
+TEST(SamplingPlan, MixturePdfIsTheWeightedSum) {
+  const Scene scene = one_target_scene(false);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=1,light=3"), scene);
+  const Vec3 origin(0.0f), normal(0, 1, 0);
+  const Vec3 up(0, 1, 0);  // hits the target: d = 5, cos = 1, area 1 -> 25
+  EXPECT_NEAR(plan.pdf(origin, normal, up), 0.25f * std::numbers::inv_pi_v<float> + 0.75f * 25.0f, 1e-4f);
+  const Vec3 side = normalize(Vec3(1, 1, 0));  // misses the target
+  EXPECT_NEAR(plan.pdf(origin, normal, side), 0.25f * side.y * std::numbers::inv_pi_v<float>, 1e-6f);
+}
+
+// With the target below the horizon, the light technique is the only one that
+// can produce a downward direction, and the hemisphere techniques the only ones
+// that produce upward directions: the side of each sample says who drew it.
+TEST(SamplingPlan, ZeroWeightTechniqueIsNeverSampled) {
+  const Scene scene = one_target_scene(true);
+  const Vec3 origin(0.0f), normal(0, 1, 0);
+  constexpr int kSamples = 20000;
+
+  const SamplingPlan only_cosine = SamplingPlan::make(Strategy::parse("mix:cosine=1,light=0"), scene);
+  Rng rng(1, 2);
+  for (int i = 0; i < kSamples; ++i) {
+    const DirectionSample ds = only_cosine.sample(origin, normal, rng);
+    ASSERT_GT(ds.direction.y, 0.0f) << "sample " << i << " went below the horizon: the light technique was used";
+    ASSERT_NEAR(ds.pdf, cosine_hemisphere_pdf(normal, ds.direction), 1e-4f);
+  }
+
+  const SamplingPlan only_light = SamplingPlan::make(Strategy::parse("mix:cosine=0,light=1"), scene);
+  for (int i = 0; i < kSamples; ++i) {
+    const DirectionSample ds = only_light.sample(origin, normal, rng);
+    ASSERT_LT(ds.direction.y, 0.0f) << "sample " << i << " went up: the cosine technique was used";
+  }
+
+  // A zero weight in the middle of the list: uniform-sphere would send some
+  // directions below the horizon that miss the small target.
+  const SamplingPlan middle =
+      SamplingPlan::make(Strategy::parse("mix:cosine=0.5,uniform-sphere=0,light=0.5"), scene);
+  int down = 0;
+  for (int i = 0; i < kSamples; ++i) {
+    const DirectionSample ds = middle.sample(origin, normal, rng);
+    if (ds.direction.y < 0.0f) {
+      ++down;
+      ASSERT_GT(quad_hit_distance(scene.quads[0], origin, ds.direction), 0.0f)
+          << "a downward sample missed the target: uniform-sphere was used";
+    }
+  }
+  // Half the samples come from the light technique: 10000 +- 4 sigma (sigma = 71).
+  EXPECT_NEAR(down, kSamples / 2, 4 * 71);
+}
+
+TEST(SamplingPlan, LightWithoutTargetsIsAnInputError) {
+  Scene scene = one_target_scene(false);
+  scene.targets.clear();
+  try {
+    (void)SamplingPlan::make(Strategy::parse("light"), scene);
+    FAIL() << "`light` on a scene without targets was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("one target"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)SamplingPlan::make(Strategy::parse("mix:light=1,cosine=0"), scene), InputError);
+  // With another technique the light's share moves to it.
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), scene);
+  EXPECT_EQ(plan.weight[static_cast<int>(Technique::Cosine)], 1.0f);
+  EXPECT_EQ(plan.weight[static_cast<int>(Technique::Light)], 0.0f);
+}
+
+}  // namespace
+}  // namespace pdflab

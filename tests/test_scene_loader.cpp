@@ -1,0 +1,417 @@
+// Scene loading: the book's scene comes out as DESIGN.md/INTERFACE.md describe,
+// and every class of bad input is an InputError whose message points at the
+// offending JSON path (or line and column for syntax errors).
+#include "renderer/error.h"
+#include "renderer/scene/scene_loader.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <initializer_list>
+#include <numbers>
+#include <string>
+
+namespace pdflab {
+namespace {
+
+using json = nlohmann::json;
+
+const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json";
+
+// A small valid scene that each validation test breaks in exactly one place.
+json minimal_scene() {
+  return json::parse(R"({
+    "name": "minimal",
+    "camera": { "width": 8, "height": 6, "vfov": 40,
+                "lookfrom": [0, 0, -10], "lookat": [0, 0, 0], "vup": [0, 1, 0] },
+    "materials": {
+      "white": { "type": "lambertian", "albedo": [0.5, 0.5, 0.5] },
+      "lamp":  { "type": "diffuse_light", "emit": [4, 4, 4] }
+    },
+    "objects": [
+      { "type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white" },
+      { "type": "quad", "q": [-1, 3, -1], "u": [2, 0, 0], "v": [0, 0, 2], "material": "lamp" }
+    ]
+  })");
+}
+
+// The message of the InputError that loading `text` throws; fails the test if
+// loading succeeds or throws anything else.
+std::string load_error(const std::string& text) {
+  try {
+    (void)load_scene_text(text, "scene.json");
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected InputError, but the scene loaded:\n" << text;
+  return {};
+}
+
+void expect_error_mentions(const json& doc, std::initializer_list<const char*> needles) {
+  const std::string message = load_error(doc.dump());
+  for (const char* needle : needles)
+    EXPECT_NE(message.find(needle), std::string::npos) << "message '" << message << "' lacks '" << needle << "'";
+  EXPECT_EQ(message.rfind("scene.json", 0), 0u) << "message should start with the origin: " << message;
+}
+
+TEST(SceneLoader, MinimalSceneLoads) {
+  // The base of every validation test must itself be valid, or those tests prove nothing.
+  const Scene s = load_scene_text(minimal_scene().dump(), "scene.json");
+  EXPECT_EQ(s.camera.width, 8);
+  EXPECT_EQ(s.camera.height, 6);
+  EXPECT_EQ(s.spheres.size(), 1u);
+  EXPECT_EQ(s.quads.size(), 1u);
+  // The emitter is a target by default; the lambertian sphere is not.
+  ASSERT_EQ(s.targets.size(), 1u);
+  EXPECT_EQ(s.targets[0].kind, Target::Kind::Quad);
+}
+
+// ---- The book's scene -------------------------------------------------------
+
+struct DVec {
+  double x, y, z;
+};
+
+DVec book_box_transform(double x, double y, double z) {
+  const double a = 15.0 * std::numbers::pi / 180.0;
+  return {std::cos(a) * x + std::sin(a) * z + 265.0, y, -std::sin(a) * x + std::cos(a) * z + 295.0};
+}
+
+bool near(const Vec3& p, const DVec& q, double tol) {
+  return std::fabs(p.x - q.x) < tol && std::fabs(p.y - q.y) < tol && std::fabs(p.z - q.z) < tol;
+}
+
+TEST(SceneLoader, BookSceneCounts) {
+  const Scene s = load_scene_file(kBookScene);
+  EXPECT_EQ(s.quads.size(), 12u);  // 5 walls, the light, 6 box faces
+  EXPECT_EQ(s.spheres.size(), 1u);
+  EXPECT_EQ(s.camera.width, 600);
+  EXPECT_EQ(s.camera.height, 600);
+  EXPECT_FLOAT_EQ(s.camera.vfov_degrees, 40.0f);
+  EXPECT_EQ(s.max_depth, 50);
+
+  ASSERT_EQ(s.targets.size(), 2u);
+  const Target& light = s.targets[0];
+  const Target& glass = s.targets[1];
+  ASSERT_EQ(light.kind, Target::Kind::Quad);
+  ASSERT_EQ(glass.kind, Target::Kind::Sphere);
+  ASSERT_LT(light.index, s.quads.size());
+  ASSERT_LT(glass.index, s.spheres.size());
+  EXPECT_EQ(s.materials[s.quads[light.index].material].type, MaterialType::DiffuseLight);
+  EXPECT_EQ(s.materials[s.quads[light.index].material].emit, Vec3(15.0f));
+  const Sphere& sphere = s.spheres[glass.index];
+  EXPECT_EQ(s.materials[sphere.material].type, MaterialType::Dielectric);
+  EXPECT_FLOAT_EQ(s.materials[sphere.material].ior, 1.5f);
+  EXPECT_EQ(sphere.center, Vec3(190.0f, 90.0f, 190.0f));
+  EXPECT_FLOAT_EQ(sphere.radius, 90.0f);
+}
+
+TEST(SceneLoader, BookLightFacesDown) {
+  const Scene s = load_scene_file(kBookScene);
+  const Quad& light = s.quads[s.targets[0].index];
+  EXPECT_EQ(light.q, Vec3(213.0f, 554.0f, 227.0f));
+  // (130,0,0) x (0,0,105) = (0, -13650, 0): the front face looks at the floor.
+  EXPECT_NEAR(light.normal.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(light.normal.y, -1.0f, 1e-6f);
+  EXPECT_NEAR(light.normal.z, 0.0f, 1e-6f);
+  EXPECT_NEAR(light.area, 130.0f * 105.0f, 1e-2f);
+  const Vec3 uxv = cross(light.u, light.v);
+  EXPECT_GT(dot(uxv, light.normal), 0.0f);
+}
+
+TEST(SceneLoader, BookBoxIsRotatedThenTranslated) {
+  const Scene s = load_scene_file(kBookScene);
+  // The box is the only object after the light: quads 6..11.
+  const DVec centre = book_box_transform(82.5, 165.0, 82.5);
+  const DVec far_corner = book_box_transform(165.0, 330.0, 165.0);
+  const DVec origin_corner = book_box_transform(0.0, 0.0, 0.0);
+  bool saw_far = false, saw_origin = false;
+  double total_area = 0.0;
+  for (std::size_t i = 6; i < 12; ++i) {
+    const Quad& f = s.quads[i];
+    EXPECT_EQ(s.material_names[f.material], "white");
+    total_area += f.area;
+    const Vec3 corners[4] = {f.q, f.q + f.u, f.q + f.v, f.q + f.u + f.v};
+    for (const Vec3& c : corners) {
+      saw_far = saw_far || near(c, far_corner, 1e-3);
+      saw_origin = saw_origin || near(c, origin_corner, 1e-3);
+    }
+    // Outward: the face centre lies on the side of the box centre opposite to
+    // where the normal points, at half the box's extent along that normal.
+    const Vec3 mid = f.q + 0.5f * (f.u + f.v);
+    const double dx = mid.x - centre.x, dy = mid.y - centre.y, dz = mid.z - centre.z;
+    const double along = dx * f.normal.x + dy * f.normal.y + dz * f.normal.z;
+    EXPECT_GT(along, 80.0) << "face " << i << " normal does not point away from the box centre";
+    EXPECT_NEAR(length(f.normal), 1.0f, 1e-5f);
+  }
+  EXPECT_TRUE(saw_far) << "no face has the corner (165,330,165) rotated 15 deg about y and moved by (265,0,295)";
+  EXPECT_TRUE(saw_origin) << "no face has the corner (0,0,0) moved to (265,0,295)";
+  EXPECT_NEAR(total_area, 2.0 * (165.0 * 330.0 * 2.0 + 165.0 * 165.0), 1.0);
+
+  // The box's +x face normal is x rotated by +15 degrees about y: (cos 15, 0, -sin 15).
+  const double a = 15.0 * std::numbers::pi / 180.0;
+  bool saw_rotated_x = false;
+  for (std::size_t i = 6; i < 12; ++i) {
+    const Vec3& n = s.quads[i].normal;
+    saw_rotated_x = saw_rotated_x || (std::fabs(n.x - std::cos(a)) < 1e-5 && std::fabs(n.y) < 1e-6 &&
+                                      std::fabs(n.z + std::sin(a)) < 1e-5);
+  }
+  EXPECT_TRUE(saw_rotated_x);
+}
+
+TEST(SceneLoader, ImportanceFlagOverridesTheDefault) {
+  json doc = minimal_scene();
+  doc["objects"][0]["importance"] = true;
+  doc["objects"][1]["importance"] = false;
+  const Scene s = load_scene_text(doc.dump(), "scene.json");
+  ASSERT_EQ(s.targets.size(), 1u);
+  EXPECT_EQ(s.targets[0].kind, Target::Kind::Sphere);
+  EXPECT_EQ(s.targets[0].index, 0u);
+}
+
+TEST(SceneLoader, MissingFileNamesThePath) {
+  try {
+    (void)load_scene_file("/nonexistent-folder/scene.json");
+    FAIL() << "loading a missing file succeeded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/scene.json"), std::string::npos) << e.what();
+  }
+}
+
+// ---- Validation errors name the JSON path ------------------------------------
+
+TEST(SceneValidation, UnknownKeys) {
+  json doc = minimal_scene();
+  doc["colour"] = 1;
+  expect_error_mentions(doc, {"top level", "'colour'"});
+
+  doc = minimal_scene();
+  doc["camera"]["fov"] = 40;
+  expect_error_mentions(doc, {"camera:", "'fov'"});
+
+  doc = minimal_scene();
+  doc["materials"]["white"]["fuzz"] = 0.1;  // fuzz belongs to metal only
+  expect_error_mentions(doc, {"materials.white:", "'fuzz'"});
+
+  doc = minimal_scene();
+  doc["objects"][1]["radius"] = 3;  // a quad has no radius
+  expect_error_mentions(doc, {"objects[1]:", "'radius'"});
+}
+
+TEST(SceneValidation, MissingKeys) {
+  json doc = minimal_scene();
+  doc["camera"].erase("width");
+  expect_error_mentions(doc, {"camera:", "missing key 'width'"});
+
+  doc = minimal_scene();
+  doc["objects"][0].erase("radius");
+  expect_error_mentions(doc, {"objects[0]:", "missing key 'radius'"});
+
+  doc = minimal_scene();
+  doc["materials"]["lamp"].erase("emit");
+  expect_error_mentions(doc, {"materials.lamp:", "missing key 'emit'"});
+
+  doc = minimal_scene();
+  doc.erase("objects");
+  expect_error_mentions(doc, {"missing key 'objects'"});
+}
+
+TEST(SceneValidation, WrongTypes) {
+  json doc = minimal_scene();
+  doc["camera"]["width"] = "600";
+  expect_error_mentions(doc, {"camera.width:", "expected an integer"});
+
+  doc = minimal_scene();
+  doc["camera"]["width"] = 600.5;
+  expect_error_mentions(doc, {"camera.width:", "expected an integer"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["radius"] = "1";
+  expect_error_mentions(doc, {"objects[0].radius:", "expected a number"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["center"] = json::array({1, 2});
+  expect_error_mentions(doc, {"objects[0].center:", "3 numbers"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["center"] = json::array({1, "2", 3});
+  expect_error_mentions(doc, {"objects[0].center[1]:", "expected a number"});
+
+  doc = minimal_scene();
+  doc["materials"]["white"]["albedo"] = "red";
+  expect_error_mentions(doc, {"materials.white.albedo:"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["importance"] = 1;
+  expect_error_mentions(doc, {"objects[0].importance:", "true or false"});
+
+  doc = minimal_scene();
+  doc["objects"] = json::object();
+  expect_error_mentions(doc, {"objects:", "expected an array"});
+
+  doc = minimal_scene();
+  doc["camera"] = json::array();
+  expect_error_mentions(doc, {"camera:", "expected an object"});
+}
+
+TEST(SceneValidation, TooLargeFiniteNumbers) {
+  // Finite in double but not in float (the renderer's type): must not turn into inf silently.
+  json doc = minimal_scene();
+  doc["objects"][0]["radius"] = 1e300;
+  expect_error_mentions(doc, {"objects[0].radius:"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["center"] = json::array({0, -4e38, 0});
+  expect_error_mentions(doc, {"objects[0].center[1]:"});
+}
+
+TEST(SceneValidation, OverflowingExponentIsAnInputError) {
+  // JSON has no NaN/Infinity literal; the way to smuggle one in is an exponent
+  // past double's range. nlohmann/json refuses it while parsing (out_of_range
+  // 406), so it must reach the user as an InputError with a location, like any
+  // other syntax-level problem, not as a stray library exception.
+  std::string text = minimal_scene().dump(2);
+  const std::string needle = "\"radius\": 1";
+  const auto at = text.find(needle);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, needle.size(), "\"radius\": 1e999");
+  const std::string message = load_error(text);
+  EXPECT_NE(message.find("line "), std::string::npos) << message;
+  EXPECT_NE(message.find("1e999"), std::string::npos) << message;
+
+  text.replace(text.find("1e999"), 5, "-1e999");
+  (void)load_error(text);
+}
+
+TEST(SceneValidation, UnknownMaterialName) {
+  json doc = minimal_scene();
+  doc["objects"][1]["material"] = "lava";
+  expect_error_mentions(doc, {"objects[1].material:", "'lava'"});
+
+  doc = minimal_scene();
+  doc["materials"]["white"]["type"] = "plastic";
+  expect_error_mentions(doc, {"materials.white.type:", "'plastic'"});
+
+  doc = minimal_scene();
+  doc["objects"][0]["type"] = "cylinder";
+  expect_error_mentions(doc, {"objects[0].type:", "'cylinder'"});
+}
+
+TEST(SceneValidation, DegenerateQuads) {
+  json doc = minimal_scene();
+  doc["objects"][1]["v"] = json::array({4, 0, 0});  // parallel to u
+  expect_error_mentions(doc, {"objects[1]", "degenerate"});
+
+  doc = minimal_scene();
+  doc["objects"][1]["u"] = json::array({0, 0, 0});
+  expect_error_mentions(doc, {"objects[1]", "degenerate"});
+
+  doc = minimal_scene();
+  doc["objects"][1]["v"] = json::array({-2, 0, 0});  // antiparallel
+  expect_error_mentions(doc, {"objects[1]", "degenerate"});
+}
+
+TEST(SceneValidation, NonPositiveRadius) {
+  for (double r : {0.0, -1.0, -0.0}) {
+    json doc = minimal_scene();
+    doc["objects"][0]["radius"] = r;
+    expect_error_mentions(doc, {"objects[0].radius:", "> 0"});
+  }
+}
+
+TEST(SceneValidation, ImageSizeRange) {
+  for (int w : {0, -1, 16385}) {
+    json doc = minimal_scene();
+    doc["camera"]["width"] = w;
+    expect_error_mentions(doc, {"camera.width:", "1..16384"});
+    doc = minimal_scene();
+    doc["camera"]["height"] = w;
+    expect_error_mentions(doc, {"camera.height:", "1..16384"});
+  }
+  // The limits themselves are valid.
+  for (int w : {1, 16384}) {
+    json doc = minimal_scene();
+    doc["camera"]["width"] = w;
+    doc["camera"]["height"] = w;
+    EXPECT_NO_THROW((void)load_scene_text(doc.dump(), "scene.json")) << w;
+  }
+}
+
+TEST(SceneValidation, HugeIntegerWidthIsRejected) {
+  // Larger than long long: must still be "out of range", never wrap into range.
+  json doc = minimal_scene();
+  doc["camera"]["width"] = 18446744073709551615ULL;
+  expect_error_mentions(doc, {"camera.width:"});
+}
+
+TEST(SceneValidation, FieldOfView) {
+  for (double v : {0.0, 180.0, -10.0, 270.0}) {
+    json doc = minimal_scene();
+    doc["camera"]["vfov"] = v;
+    expect_error_mentions(doc, {"camera.vfov:"});
+  }
+  json doc = minimal_scene();
+  doc["camera"]["vfov"] = 179.5;
+  EXPECT_NO_THROW((void)load_scene_text(doc.dump(), "scene.json"));
+}
+
+TEST(SceneValidation, UpVectorParallelToView) {
+  // View direction is +z (lookfrom z=-10 towards the origin).
+  for (const auto& vup : {json::array({0, 0, 1}), json::array({0, 0, -3}), json::array({0, 0, 0})}) {
+    json doc = minimal_scene();
+    doc["camera"]["vup"] = vup;
+    expect_error_mentions(doc, {"camera", "vup"});
+  }
+  json doc = minimal_scene();
+  doc["camera"]["lookat"] = doc["camera"]["lookfrom"];
+  expect_error_mentions(doc, {"camera", "lookfrom"});
+}
+
+TEST(SceneValidation, BoxExtentsAndMaterialRanges) {
+  json doc = minimal_scene();
+  doc["objects"][0] = json::parse(R"({"type": "box", "min": [0,0,0], "max": [1,0,1], "material": "white"})");
+  expect_error_mentions(doc, {"objects[0]", "max"});
+
+  doc = minimal_scene();
+  doc["materials"]["white"]["albedo"] = json::array({0.5, -0.1, 0.5});
+  expect_error_mentions(doc, {"materials.white.albedo:", ">= 0"});
+
+  doc = minimal_scene();
+  doc["materials"]["alu"] = json::parse(R"({"type": "metal", "albedo": [1,1,1], "fuzz": 1.5})");
+  expect_error_mentions(doc, {"materials.alu.fuzz:"});
+}
+
+// ---- Syntax errors report line and column ------------------------------------
+
+TEST(SceneSyntax, LineAndColumnMidLine) {
+  // The second comma on line 3 is column 16: 4 spaces, "width": (8), a space, 8, comma.
+  const std::string text = "{\n  \"camera\": {\n    \"width\": 8,,\n  }\n}\n";
+  const std::string message = load_error(text);
+  EXPECT_NE(message.find("line 3, column 16"), std::string::npos) << message;
+  EXPECT_NE(message.find("syntax"), std::string::npos) << message;
+}
+
+TEST(SceneSyntax, LineAndColumnAtStartOfLine) {
+  const std::string text = "{\n\"camera\":\n]\n";
+  const std::string message = load_error(text);
+  EXPECT_NE(message.find("line 3, column 1"), std::string::npos) << message;
+}
+
+TEST(SceneSyntax, TruncatedFile) {
+  std::string text = minimal_scene().dump(2);
+  text.resize(text.size() / 2);
+  const std::string message = load_error(text);
+  EXPECT_NE(message.find("line "), std::string::npos) << message;
+}
+
+TEST(SceneSyntax, NotAnObject) {
+  const std::string message = load_error("[1, 2, 3]");
+  EXPECT_NE(message.find("top level"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace pdflab
