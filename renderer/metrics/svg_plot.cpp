@@ -109,13 +109,26 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
         break;
       }
     if (gx > 0.0) {
-      const double xa = std::pow(10.0, lx0), xb = std::pow(10.0, lx1);
-      double ya = gy * std::pow(xa / gx, o.guide_slope), yb = gy * std::pow(xb / gx, o.guide_slope);
-      svg += "<clipPath id=\"plot\"><rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" +
-             fmt("%.1f", pw) + "\" height=\"" + fmt("%.1f", ph) + "\"/></clipPath>\n";
-      svg += "<line clip-path=\"url(#plot)\" x1=\"" + fmt("%.1f", px(xa)) + "\" y1=\"" + fmt("%.1f", py(ya)) +
-             "\" x2=\"" + fmt("%.1f", px(xb)) + "\" y2=\"" + fmt("%.1f", py(yb)) +
-             "\" stroke=\"#555\" stroke-dasharray=\"5,4\"/>\n";
+      // The line log y = log gy + slope (log x - log gx), clipped to the plot box
+      // in log space (so it renders the same in every SVG viewer).
+      const double s0 = o.guide_slope, c0 = std::log10(gy) - s0 * std::log10(gx);
+      double la = lx0, lb = lx1;
+      auto ly_at = [&](double lx) { return c0 + s0 * lx; };
+      auto lx_at = [&](double ly) { return (ly - c0) / s0; };
+      for (double edge : {ly0, ly1}) {
+        const double cross_x = lx_at(edge);
+        if (cross_x > la && cross_x < lb) {
+          // Keep the part inside: drop the side whose y lies beyond this edge.
+          const bool left_outside = (edge == ly1) ? ly_at(la) > ly1 : ly_at(la) < ly0;
+          (left_outside ? la : lb) = cross_x;
+        }
+      }
+      if (ly_at(la) <= ly1 + 1e-9 && ly_at(la) >= ly0 - 1e-9) {
+        const double xa = std::pow(10.0, la), xb = std::pow(10.0, lb);
+        svg += "<line x1=\"" + fmt("%.1f", px(xa)) + "\" y1=\"" + fmt("%.1f", py(std::pow(10.0, ly_at(la)))) +
+               "\" x2=\"" + fmt("%.1f", px(xb)) + "\" y2=\"" + fmt("%.1f", py(std::pow(10.0, ly_at(lb)))) +
+               "\" stroke=\"#555\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"/>\n";
+      }
       legend("#555", o.guide_label, true);
     }
   }
