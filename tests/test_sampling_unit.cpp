@@ -206,12 +206,26 @@ TEST(StrategyParse, SingleTechniques) {
                {"uniform-hemisphere", Technique::UniformHemisphere},
                {"uniform-sphere", Technique::UniformSphere},
                {"light", Technique::Light},
+               {"light-sa", Technique::LightSolidAngle},
                {"  light ", Technique::Light}};
   for (const auto& c : cases) {
     const Strategy s = Strategy::parse(c.text);
     for (int i = 0; i < kTechniqueCount; ++i)
       EXPECT_EQ(s.weights[i], i == static_cast<int>(c.t) ? 1.0f : 0.0f) << c.text << " technique " << i;
   }
+}
+
+TEST(StrategyParse, NextEventEstimation) {
+  const Strategy power = Strategy::parse("nee-mis");
+  EXPECT_TRUE(power.nee_mis);
+  EXPECT_EQ(power.heuristic, MisHeuristic::Power);
+  EXPECT_EQ(Strategy::parse("nee-mis:power"), power);
+  const Strategy balance = Strategy::parse("nee-mis:balance");
+  EXPECT_TRUE(balance.nee_mis);
+  EXPECT_EQ(balance.heuristic, MisHeuristic::Balance);
+  EXPECT_EQ(Strategy::parse(balance.to_string()), balance);
+  EXPECT_EQ(Strategy::parse(power.to_string()), power);
+  EXPECT_TRUE(power.is_unbiased());
 }
 
 TEST(StrategyParse, Mixtures) {
@@ -258,7 +272,8 @@ TEST(StrategyParse, Rejections) {
   expect_rejected("mix:cosine=1,", {"TECHNIQUE=WEIGHT"});
   expect_rejected("", {"empty strategy"});
   expect_rejected("   ", {"empty strategy"});
-  expect_rejected("light-sa", {"not available"});
+  expect_rejected("mix:cosine=0.5,nee-mis=0.5", {"cannot be mixed"});
+  expect_rejected("nee-mis:fast", {"'power' or 'balance'"});
 }
 
 TEST(StrategyParse, ToStringRoundTrips) {

@@ -32,7 +32,122 @@ inline float schlick(float cosine, float eta_ratio) {
 
 }  // namespace
 
+// Weight of technique `a` against `b` for a sample both could have drawn.
+inline float mis_weight(float a, float b, MisHeuristic h) {
+  if (h == MisHeuristic::Power) {
+    a *= a;
+    b *= b;
+  }
+  if (a == kInf) return 1.0f;  // also keeps inf/inf from becoming NaN
+  return a / (a + b);
+}
+
+// Follows a metal or dielectric bounce; returns false when the path ends.
+inline bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
+                             Vec3& throughput, Rng& rng) {
+  if (m.type == MaterialType::Metal) {
+    Vec3 dir = reflect(ray.direction, normal);
+    if (m.fuzz > 0.0f) dir = normalize(dir + random_unit_vector(rng) * m.fuzz);
+    if (dot(dir, normal) <= 0.0f) return false;  // fuzz pushed it under the surface: absorbed
+    throughput *= m.albedo;
+    ray = spawn_ray(hit.point, hit.normal, dir);
+    return true;
+  }
+  // Dielectric: Schlick reflectance, total internal reflection.
+  const float eta_ratio = front_face ? 1.0f / m.ior : m.ior;
+  const float cos_theta = min_of(-dot(ray.direction, normal), 1.0f);
+  const float sin2_theta = positive_part(1.0f - cos_theta * cos_theta);
+  const float sin2_t = eta_ratio * eta_ratio * sin2_theta;
+  Vec3 dir;
+  if (sin2_t > 1.0f || schlick(cos_theta, eta_ratio) > rng.uniform()) {
+    dir = reflect(ray.direction, normal);
+  } else {
+    const Vec3 perp = (ray.direction + normal * cos_theta) * eta_ratio;
+    const Vec3 parallel = normal * -std::sqrt(positive_part(1.0f - sin2_t));
+    dir = normalize(perp + parallel);
+  }
+  ray = spawn_ray(hit.point, hit.normal, dir);
+  return true;
+}
+
+// Next-event estimation with MIS: at each diffuse vertex one light sample
+// (shadow ray, solid-angle sampling of the emitters chosen by power) and one
+// cosine sample. Emission reached by the cosine sample is weighted against the
+// light technique's density for the same direction, and vice versa, so each
+// light path is counted once in total.
+Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
+  Vec3 radiance(0.0f);
+  Vec3 throughput(1.0f);
+  bool unweighted_emission = true;  // camera rays and specular bounces: no light sample competes
+  float previous_pdf = 0.0f;        // the cosine sample's pdf at the last diffuse vertex
+  Vec3 previous_point(0.0f);
+  for (int depth = 0; depth < scene.max_depth; ++depth) {
+    Hit hit;
+    if (!intersect(scene, ray, kInf, hit)) {
+      radiance += throughput * scene.background;  // the background is not a light target
+      break;
+    }
+    const Material& m = scene.materials[hit.material];
+    const bool front_face = dot(ray.direction, hit.normal) < 0.0f;
+    const Vec3 normal = front_face ? hit.normal : -hit.normal;
+
+    if (m.type == MaterialType::DiffuseLight) {
+      if (front_face || m.two_sided) {
+        float w = 1.0f;
+        if (!unweighted_emission)
+          w = mis_weight(previous_pdf, plan.emitters.pdf(previous_point, ray.direction), plan.heuristic);
+        radiance += throughput * m.emit * w;
+      }
+      break;
+    }
+    if (m.type != MaterialType::Lambertian) {
+      if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) break;
+      unweighted_emission = true;
+      continue;
+    }
+
+    // The light sample.
+    if (!plan.emitters.empty()) {
+      const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const DirectionSample ls = plan.emitters.sample(hit.point, uc, u1, u2);
+      if (ls.none) {
+        // Seen edge-on from here: no light sample, and the light pdf that the
+        // material sample is weighed against is zero too.
+      } else if (!(ls.pdf > 0.0f) || ls.pdf == kInf) {
+        drops.add(ls.pdf == 0.0f || ls.pdf < 0.0f ? DropReason::PdfZero : DropReason::PdfNotFinite);
+      } else {
+        const float cosine = dot(ls.direction, normal);
+        Hit shadow_hit;
+        if (cosine > 0.0f && intersect(scene, spawn_ray(hit.point, hit.normal, ls.direction), kInf, shadow_hit)) {
+          const Material& lm = scene.materials[shadow_hit.material];
+          if (lm.type == MaterialType::DiffuseLight && (dot(ls.direction, shadow_hit.normal) < 0.0f || lm.two_sided)) {
+            const float bsdf_pdf = cosine * kInvPi;
+            const float w = mis_weight(ls.pdf, bsdf_pdf, plan.heuristic);
+            radiance += throughput * m.albedo * lm.emit * (bsdf_pdf * w / ls.pdf);
+          }
+        }
+      }
+    }
+
+    // The material sample: cosine-weighted, so f cos / p is the albedo.
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const DirectionSample ds = sample_cosine_hemisphere(Onb(normal), u1, u2);
+    if (!(ds.pdf > 0.0f)) break;  // exactly tangent: the estimate is zero
+    throughput *= m.albedo;
+    previous_pdf = ds.pdf;
+    previous_point = hit.point;
+    unweighted_emission = false;
+    ray = spawn_ray(hit.point, hit.normal, ds.direction);
+  }
+  if (!is_finite(radiance)) {
+    drops.add(DropReason::RadianceNotFinite);
+    return Vec3(0.0f);
+  }
+  return radiance;
+}
+
 Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
+  if (plan.nee_mis) return trace_path_nee(scene, plan, ray, rng, drops);
   Vec3 radiance(0.0f);
   Vec3 throughput(1.0f);
   for (int depth = 0; depth < scene.max_depth; ++depth) {
@@ -53,6 +168,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
 
     if (m.type == MaterialType::Lambertian) {
       const DirectionSample ds = plan.sample(hit.point, normal, rng);
+      if (ds.none) break;  // a light seen edge-on: a valid zero estimate
       if (!(ds.pdf > 0.0f)) {
         drops.add(std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
         break;
@@ -65,26 +181,8 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * (cosine * kInvPi / ds.pdf);
       ray = spawn_ray(hit.point, hit.normal, ds.direction);
-    } else if (m.type == MaterialType::Metal) {
-      Vec3 dir = reflect(ray.direction, normal);
-      if (m.fuzz > 0.0f) dir = normalize(dir + random_unit_vector(rng) * m.fuzz);
-      if (dot(dir, normal) <= 0.0f) break;  // fuzz pushed it under the surface: absorbed
-      throughput *= m.albedo;
-      ray = spawn_ray(hit.point, hit.normal, dir);
-    } else {  // Dielectric
-      const float eta_ratio = front_face ? 1.0f / m.ior : m.ior;
-      const float cos_theta = min_of(-dot(ray.direction, normal), 1.0f);
-      const float sin2_theta = positive_part(1.0f - cos_theta * cos_theta);
-      const float sin2_t = eta_ratio * eta_ratio * sin2_theta;
-      Vec3 dir;
-      if (sin2_t > 1.0f || schlick(cos_theta, eta_ratio) > rng.uniform()) {
-        dir = reflect(ray.direction, normal);
-      } else {
-        const Vec3 perp = (ray.direction + normal * cos_theta) * eta_ratio;
-        const Vec3 parallel = normal * -std::sqrt(positive_part(1.0f - sin2_t));
-        dir = normalize(perp + parallel);
-      }
-      ray = spawn_ray(hit.point, hit.normal, dir);
+    } else if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) {
+      break;
     }
   }
   if (!is_finite(radiance)) {

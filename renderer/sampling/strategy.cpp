@@ -3,6 +3,7 @@
 #include "renderer/error.h"
 
 #include <charconv>
+#include <numbers>
 #include <cstdio>
 
 namespace pdflab {
@@ -10,10 +11,7 @@ namespace pdflab {
 namespace {
 
 constexpr std::array<std::string_view, kTechniqueCount> kNames = {
-    "cosine", "uniform-hemisphere", "uniform-sphere", "light"};
-
-// Names INTERFACE.md reserves for techniques that this build does not provide yet.
-constexpr std::array<std::string_view, 2> kReserved = {"light-sa", "nee-mis"};
+    "cosine", "uniform-hemisphere", "uniform-sphere", "light", "light-sa"};
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -27,16 +25,14 @@ std::string known_list() {
     if (!out.empty()) out += ", ";
     out.append(n);
   }
-  return out + ", mix:TECHNIQUE=W,...";
+  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance";
 }
 
 Technique parse_technique(std::string_view name, std::string_view whole) {
   for (int i = 0; i < kTechniqueCount; ++i)
     if (kNames[i] == name) return static_cast<Technique>(i);
-  for (auto r : kReserved)
-    if (r == name)
-      throw InputError("strategy '" + std::string(whole) + "': '" + std::string(name) +
-                       "' is not available in this version of pdflab");
+  if (name.substr(0, 7) == "nee-mis")
+    throw InputError("strategy '" + std::string(whole) + "': nee-mis is a strategy of its own and cannot be mixed");
   throw InputError("unknown strategy '" + std::string(whole) + "'" +
                    (name != whole ? " (unknown technique '" + std::string(name) + "')" : "") +
                    "; expected one of: " + known_list());
@@ -64,9 +60,20 @@ Strategy Strategy::single(Technique t) {
   return s;
 }
 
+Strategy Strategy::nee(MisHeuristic h) {
+  Strategy s;
+  s.nee_mis = true;
+  s.heuristic = h;
+  return s;
+}
+
 Strategy Strategy::parse(std::string_view text) {
   const std::string_view whole = trim(text);
   if (whole.empty()) throw InputError("empty strategy; expected one of: " + known_list());
+  if (whole == "nee-mis" || whole == "nee-mis:power") return nee(MisHeuristic::Power);
+  if (whole == "nee-mis:balance") return nee(MisHeuristic::Balance);
+  if (whole.substr(0, 8) == "nee-mis:")
+    throw InputError("strategy '" + std::string(whole) + "': the heuristic must be 'power' or 'balance'");
   constexpr std::string_view kMix = "mix:";
   if (whole.substr(0, kMix.size()) != kMix) return single(parse_technique(whole, whole));
 
@@ -98,6 +105,7 @@ Strategy Strategy::parse(std::string_view text) {
 }
 
 std::string Strategy::to_string() const {
+  if (nee_mis) return heuristic == MisHeuristic::Power ? "nee-mis" : "nee-mis:balance";
   int used = 0, last = 0;
   for (int i = 0; i < kTechniqueCount; ++i)
     if (weights[i] > 0.0f) ++used, last = i;
@@ -118,22 +126,149 @@ std::string Strategy::to_string() const {
 }
 
 bool Strategy::is_unbiased() const {
-  return uses(Technique::Cosine) || uses(Technique::UniformHemisphere) || uses(Technique::UniformSphere);
+  return nee_mis || uses(Technique::Cosine) || uses(Technique::UniformHemisphere) || uses(Technique::UniformSphere);
 }
+
+double emitter_power(const Material& m, double area) {
+  if (m.type != MaterialType::DiffuseLight) return 0.0;
+  const double luminance = 0.2126 * m.emit.x + 0.7152 * m.emit.y + 0.0722 * m.emit.z;
+  return luminance * area * std::numbers::pi * (m.two_sided ? 2.0 : 1.0);
+}
+
+void TargetSet::set_probabilities(const std::vector<double>& weights) {
+  double total = 0.0;
+  for (double w : weights) total += w;
+  cdf.clear();
+  double running = 0.0;
+  std::size_t i = 0;
+  auto next = [&] {
+    const double p = weights[i++] / total;
+    running += p;
+    cdf.push_back(static_cast<float>(running));
+    return static_cast<float>(p);
+  };
+  for (auto& q : quads) q.probability = next();
+  for (auto& sp : spheres) sp.probability = next();
+  // Every u in [0, 1) must select a target; the last one with weight absorbs rounding.
+  for (std::size_t k = cdf.size(); k-- > 0;) {
+    const bool positive = k < quads.size() ? quads[k].probability > 0.0f : spheres[k - quads.size()].probability > 0.0f;
+    cdf[k] = 1.0f;
+    if (positive) break;
+  }
+}
+
+float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const {
+  float sum = 0.0f;
+  if (solid_angle) {
+    for (const QuadEntry& e : quads)
+      if (e.quad != skip) sum += e.probability * quad_solid_angle_pdf(*e.quad, origin, direction);
+  } else {
+    for (const QuadEntry& e : quads)
+      if (e.quad != skip) sum += e.probability * quad_area_pdf(*e.quad, origin, direction);
+  }
+  for (const SphereEntry& e : spheres)
+    if (e.sphere != skip) sum += e.probability * sphere_cone_pdf(*e.sphere, origin, direction);
+  return sum;
+}
+
+float TargetSet::pdf(const Vec3& origin, const Vec3& direction) const { return pdf_without(origin, direction, nullptr); }
+
+DirectionSample TargetSet::sample(const Vec3& origin, float u_choice, float u1, float u2) const {
+  int chosen = 0;
+  const int n = size();
+  while (chosen < n - 1 && u_choice >= cdf[chosen]) ++chosen;
+  DirectionSample ds;
+  const int nq = static_cast<int>(quads.size());
+  if (chosen < nq) {
+    const QuadEntry& e = quads[chosen];
+    ds = solid_angle ? sample_quad_solid_angle(*e.quad, origin, u1, u2) : sample_quad_area(*e.quad, origin, u1, u2);
+    if (ds.none) return ds;
+    ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.quad);
+  } else {
+    const SphereEntry& e = spheres[chosen - nq];
+    ds = sample_sphere_cone(*e.sphere, origin, u1, u2);
+    ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.sphere);
+  }
+  return ds;
+}
+
+namespace {
+
+// Fills a set with the scene's objects that `pick` accepts; returns their powers.
+template <class Pick>
+std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pick) {
+  std::vector<double> quad_power, sphere_power;
+  for (std::size_t i = 0; i < scene.quads.size(); ++i) {
+    const Quad& q = scene.quads[i];
+    if (!pick(Target{Target::Kind::Quad, static_cast<std::uint32_t>(i)})) continue;
+    set.quads.push_back({&q, 0.0f});
+    quad_power.push_back(emitter_power(scene.materials[q.material], q.area));
+  }
+  for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+    const Sphere& sp = scene.spheres[i];
+    if (!pick(Target{Target::Kind::Sphere, static_cast<std::uint32_t>(i)})) continue;
+    set.spheres.push_back({&sp, 0.0f});
+    const double area = 4.0 * std::numbers::pi * static_cast<double>(sp.radius) * sp.radius;
+    sphere_power.push_back(emitter_power(scene.materials[sp.material], area));
+  }
+  quad_power.insert(quad_power.end(), sphere_power.begin(), sphere_power.end());
+  return quad_power;
+}
+
+// Power-proportional choice; a target that emits nothing (the book's glass
+// sphere) gets the mean emitter's share, so it is still aimed at as often as
+// an average light. All-zero powers fall back to uniform.
+std::vector<double> power_weights(std::vector<double> power) {
+  double sum = 0.0;
+  int emitting = 0;
+  for (double p : power)
+    if (p > 0.0) sum += p, ++emitting;
+  const double stand_in = emitting ? sum / emitting : 1.0;
+  for (double& p : power)
+    if (!(p > 0.0)) p = stand_in;
+  return power;
+}
+
+}  // namespace
 
 SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   SamplingPlan plan;
   plan.scene = &scene;
-  plan.target_count = static_cast<int>(scene.targets.size());
-  plan.inv_target_count = plan.target_count > 0 ? 1.0f / static_cast<float>(plan.target_count) : 0.0f;
-  for (const Target& t : scene.targets) {
-    if (t.kind == Target::Kind::Quad) plan.quad_targets.push_back(&scene.quads[t.index]);
-    else plan.sphere_targets.push_back(&scene.spheres[t.index]);
+  plan.nee_mis = strategy.nee_mis;
+  plan.heuristic = strategy.heuristic;
+
+  auto is_target = [&](const Target& t) {
+    for (const Target& x : scene.targets)
+      if (x.kind == t.kind && x.index == t.index) return true;
+    return false;
+  };
+  auto is_emitter = [&](const Target& t) {
+    const std::uint32_t m = t.kind == Target::Kind::Quad ? scene.quads[t.index].material : scene.spheres[t.index].material;
+    return scene.materials[m].type == MaterialType::DiffuseLight;
+  };
+  const std::vector<double> book_power = collect_targets(scene, plan.book_targets, is_target);
+  plan.book_targets.set_probabilities(std::vector<double>(book_power.size(), 1.0));
+  plan.target_count = plan.book_targets.size();
+  (void)collect_targets(scene, plan.power_targets, is_target);
+  plan.power_targets.solid_angle = true;
+  plan.power_targets.set_probabilities(power_weights(book_power));
+  const std::vector<double> emitter_powers = collect_targets(scene, plan.emitters, is_emitter);
+  plan.emitters.solid_angle = true;
+  plan.emitters.set_probabilities(power_weights(emitter_powers));
+
+  if (strategy.nee_mis) {
+    plan.weight[static_cast<int>(Technique::Cosine)] = 1.0f;  // the material sample
+    plan.cdf.fill(1.0f);
+    return plan;
   }
+
   std::array<float, kTechniqueCount> w = strategy.weights;
   // A light technique with nothing to aim at has no distribution: its weight
   // goes to the other techniques (renormalised below).
-  if (plan.target_count == 0) w[static_cast<int>(Technique::Light)] = 0.0f;
+  if (plan.target_count == 0) {
+    w[static_cast<int>(Technique::Light)] = 0.0f;
+    w[static_cast<int>(Technique::LightSolidAngle)] = 0.0f;
+  }
   double total = 0.0;
   for (float x : w) total += x;
   if (!(total > 0.0))
@@ -153,43 +288,13 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   return plan;
 }
 
-float SamplingPlan::light_pdf_sum(const Vec3& origin, const Vec3& direction, const void* skip) const {
-  float sum = 0.0f;
-  for (const Quad* q : quad_targets)
-    if (q != skip) sum += quad_area_pdf(*q, origin, direction);
-  for (const Sphere* sp : sphere_targets)
-    if (sp != skip) sum += sphere_cone_pdf(*sp, origin, direction);
-  return sum;
-}
-
-float SamplingPlan::light_pdf(const Vec3& origin, const Vec3& direction) const {
-  return inv_target_count * light_pdf_sum(origin, direction, nullptr);
-}
-
-DirectionSample SamplingPlan::sample_light(const Vec3& origin, float u_target, float u1, float u2) const {
-  const int chosen = std::min(static_cast<int>(u_target * static_cast<float>(target_count)), target_count - 1);
-  const Target& t = scene->targets[chosen];
-  // The chosen target's pdf comes from the sampler itself (an edge sample that a
-  // re-intersection might round off the target still gets its true density).
-  DirectionSample ds;
-  if (t.kind == Target::Kind::Quad) {
-    const Quad& q = scene->quads[t.index];
-    ds = sample_quad_area(q, origin, u1, u2);
-    ds.pdf = inv_target_count * (ds.pdf + light_pdf_sum(origin, ds.direction, &q));
-  } else {
-    const Sphere& sp = scene->spheres[t.index];
-    ds = sample_sphere_cone(sp, origin, u1, u2);
-    ds.pdf = inv_target_count * (ds.pdf + light_pdf_sum(origin, ds.direction, &sp));
-  }
-  return ds;
-}
-
 float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const {
   float p = 0.0f;
   if (weight[0] > 0.0f) p += weight[0] * cosine_hemisphere_pdf(normal, direction);
   if (weight[1] > 0.0f) p += weight[1] * uniform_hemisphere_pdf(normal, direction);
   if (weight[2] > 0.0f) p += weight[2] * uniform_sphere_pdf();
-  if (weight[3] > 0.0f) p += weight[3] * light_pdf(origin, direction);
+  if (weight[3] > 0.0f) p += weight[3] * book_targets.pdf(origin, direction);
+  if (weight[4] > 0.0f) p += weight[4] * power_targets.pdf(origin, direction);
   return p;
 }
 
@@ -205,9 +310,10 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
     case Technique::Cosine: ds = sample_cosine_hemisphere(Onb(normal), u1, u2); break;
     case Technique::UniformHemisphere: ds = sample_uniform_hemisphere(Onb(normal), u1, u2); break;
     case Technique::UniformSphere: ds = sample_uniform_sphere(u1, u2); break;
-    default: ds = sample_light(origin, rng.uniform(), u1, u2); break;
+    case Technique::Light: ds = book_targets.sample(origin, rng.uniform(), u1, u2); break;
+    default: ds = power_targets.sample(origin, rng.uniform(), u1, u2); break;
   }
-  if (weight[chosen] == 1.0f) return ds;  // a single technique: its own pdf is the mixture's
+  if (ds.none || weight[chosen] == 1.0f) return ds;  // a single technique: its own pdf is the mixture's
 
   // One-sample mixture: the density of the direction under every technique.
   // The hemisphere terms are cheap and branch-free (a zero weight adds zero).
@@ -215,12 +321,15 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   // rounding puts exactly on the horizon cannot get a zero mixture pdf.
   const float c = dot(normal, ds.direction);
   const float above = c > 0.0f ? 1.0f : 0.0f;
-  const int light = static_cast<int>(Technique::Light);
+  constexpr int light = static_cast<int>(Technique::Light), light_sa = static_cast<int>(Technique::LightSolidAngle);
   const float light_term =
-      chosen == light ? ds.pdf : (weight[light] > 0.0f ? light_pdf(origin, ds.direction) : 0.0f);
+      chosen == light ? ds.pdf : (weight[light] > 0.0f ? book_targets.pdf(origin, ds.direction) : 0.0f);
+  const float light_sa_term =
+      chosen == light_sa ? ds.pdf : (weight[light_sa] > 0.0f ? power_targets.pdf(origin, ds.direction) : 0.0f);
   ds.pdf = weight[0] * (chosen == 0 ? ds.pdf : above * c * kInvPi) +
            weight[1] * (chosen == 1 ? ds.pdf : above * kInv2Pi) +
-           weight[2] * (chosen == 2 ? ds.pdf : kInv4Pi) + weight[light] * light_term;
+           weight[2] * (chosen == 2 ? ds.pdf : kInv4Pi) + weight[light] * light_term +
+           weight[light_sa] * light_sa_term;
   return ds;
 }
 

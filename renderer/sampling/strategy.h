@@ -1,7 +1,7 @@
 #pragma once
 // A sampling strategy: which techniques draw the scattered direction at a
-// diffuse bounce and with which weights. A small value decided once per pass;
-// nothing here allocates per ray.
+// diffuse bounce and with which weights, or next-event estimation with MIS.
+// A small value decided once per pass; nothing here allocates per ray.
 #include "renderer/math.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/techniques.h"
@@ -14,38 +14,88 @@
 
 namespace pdflab {
 
-enum class Technique : std::uint8_t { Cosine, UniformHemisphere, UniformSphere, Light, Count };
+enum class Technique : std::uint8_t {
+  Cosine,
+  UniformHemisphere,
+  UniformSphere,
+  Light,            // the book's: targets chosen uniformly, quads by area, spheres by cone
+  LightSolidAngle,  // targets chosen by power, quads by spherical rectangle, spheres by cone
+  Count
+};
 inline constexpr int kTechniqueCount = static_cast<int>(Technique::Count);
 
 std::string_view technique_name(Technique t);
 
-// As typed by the user: `cosine`, `mix:cosine=1,light=3`, ... Weights are kept as
-// given (normalised by SamplingPlan). Parsing validates; see INTERFACE.md.
+enum class MisHeuristic : std::uint8_t { Balance, Power };
+
+// As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,
+// `nee-mis:balance`... Mixture weights are kept as given (normalised by
+// SamplingPlan). Parsing validates; see README.md.
 struct Strategy {
   std::array<float, kTechniqueCount> weights{};
+  // Next-event estimation: at each diffuse vertex one light sample (shadow ray,
+  // solid-angle sampling of the emitters chosen by power) and one cosine
+  // sample, combined with multiple importance sampling. `weights` is unused.
+  bool nee_mis = false;
+  MisHeuristic heuristic = MisHeuristic::Power;
 
   static Strategy parse(std::string_view text);  // throws InputError
   static Strategy single(Technique t);
+  static Strategy nee(MisHeuristic h = MisHeuristic::Power);
   std::string to_string() const;  // canonical form, parses back to the same value
 
   // Unbiased iff some technique with positive weight covers the whole
   // hemisphere above a diffuse surface (light techniques cover only the targets).
   bool is_unbiased() const;
-  bool uses(Technique t) const { return weights[static_cast<int>(t)] > 0.0f; }
+  bool uses(Technique t) const { return !nee_mis && weights[static_cast<int>(t)] > 0.0f; }
+  bool operator==(const Strategy&) const = default;
+};
+
+// Importance targets with the probability of choosing each, split by kind so
+// that evaluating their pdf needs no per-target switch.
+struct TargetSet {
+  struct QuadEntry {
+    const Quad* quad;
+    float probability;
+  };
+  struct SphereEntry {
+    const Sphere* sphere;
+    float probability;
+  };
+  std::vector<QuadEntry> quads;
+  std::vector<SphereEntry> spheres;
+  std::vector<float> cdf;  // over quads, then spheres
+  bool solid_angle = false;  // quads by spherical rectangle instead of by area
+
+  bool empty() const { return cdf.empty(); }
+  int size() const { return static_cast<int>(cdf.size()); }
+  // Probabilities proportional to `weights` (same order: quads, then spheres).
+  void set_probabilities(const std::vector<double>& weights);
+
+  // A direction towards one target (chosen with u_choice), its pdf being the
+  // set's: sum over targets of probability * per-target pdf. The chosen target's
+  // density comes from its sampler, the others' from evaluation.
+  DirectionSample sample(const Vec3& origin, float u_choice, float u1, float u2) const;
+  float pdf(const Vec3& origin, const Vec3& direction) const;
+
+ private:
+  float pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const;
 };
 
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
-// distribution, and the importance targets. Built once per render/pass; it
-// points into the scene, which must outlive it and stay where it is.
+// distribution, and the target sets. Built once per render; it points into the
+// scene, which must outlive it and stay where it is.
 struct SamplingPlan {
   std::array<float, kTechniqueCount> weight{};  // normalised, sum to 1
   std::array<float, kTechniqueCount> cdf{};     // cdf[i] = weight[0] + ... + weight[i]
   const Scene* scene = nullptr;
-  int target_count = 0;
-  float inv_target_count = 0.0f;
-  // The targets split by kind, so evaluating the light pdf needs no per-target switch.
-  std::vector<const Quad*> quad_targets;
-  std::vector<const Sphere*> sphere_targets;
+  bool nee_mis = false;
+  MisHeuristic heuristic = MisHeuristic::Power;
+
+  TargetSet book_targets;   // `light`: the importance targets, chosen uniformly
+  TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
+  TargetSet emitters;       // `nee-mis`: every emitter, by power
+  int target_count = 0;     // importance targets
 
   // Throws InputError when the strategy needs targets the scene does not have
   // and no other technique has weight.
@@ -57,13 +107,15 @@ struct SamplingPlan {
   // The mixture's pdf for any unit direction.
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
 
-  // The `light` technique alone: uniform choice among targets, then area/cone sampling.
-  DirectionSample sample_light(const Vec3& origin, float u_target, float u1, float u2) const;
-  float light_pdf(const Vec3& origin, const Vec3& direction) const;
-
- private:
-  // Sum of the per-target pdfs, leaving out the target at `skip` (or none).
-  float light_pdf_sum(const Vec3& origin, const Vec3& direction, const void* skip) const;
+  // The `light` technique alone (the book's hittable_pdf over the targets).
+  DirectionSample sample_light(const Vec3& origin, float u_target, float u1, float u2) const {
+    return book_targets.sample(origin, u_target, u1, u2);
+  }
+  float light_pdf(const Vec3& origin, const Vec3& direction) const { return book_targets.pdf(origin, direction); }
 };
+
+// How much light an emitter sends out (luminance of emit * area * pi, doubled
+// when two-sided): the weight for choosing it in proportion to its power.
+double emitter_power(const Material& m, double area);
 
 }  // namespace pdflab

@@ -11,6 +11,12 @@ namespace pdflab {
 struct DirectionSample {
   Vec3 direction;
   float pdf;
+  // The technique has no direction to offer from here: a light seen exactly
+  // edge-on (the shading point in its plane) subtends no solid angle. That is a
+  // valid zero estimate, not an invalid sample: the technique's density is zero
+  // for every direction at this point, and the mixture or MIS estimator stays
+  // unbiased when it contributes nothing.
+  bool none = false;
 };
 
 // ---- Hemisphere and sphere techniques (relative to a shading normal) -------
@@ -61,7 +67,8 @@ inline DirectionSample sample_quad_area(const Quad& quad, const Vec3& origin, fl
   const Vec3 direction = to_point * (1.0f / dist);
   const float cosine = std::fabs(dot(direction, quad.normal));
   // dist2 == 0 (origin on the sampled point) or cosine == 0 (origin in the
-  // quad's plane) give an infinite or NaN pdf; the integrator drops and counts them.
+  // quad's plane): the quad is seen edge-on and offers no direction.
+  if (!(dist2 > 0.0f) || !(cosine > 0.0f)) return {quad.normal, 0.0f, true};
   return {direction, dist2 / (cosine * quad.area)};
 }
 
@@ -143,5 +150,34 @@ inline float sphere_cone_pdf(const Sphere& sphere, const Vec3& origin, const Vec
   const float one_minus_cos_max = sin2_max / (1.0f + std::sqrt(positive_part(1.0f - sin2_max)));
   return 1.0f / (2.0f * kPi * one_minus_cos_max);
 }
+
+// ---- Solid-angle sampling of a rectangle (spherical rectangle) -------------
+// Ureña, Fajardo and King, "An Area-Preserving Parametrization for Spherical
+// Rectangles" (EGSR 2013): directions uniform over the solid angle the
+// rectangle subtends, p = 1 / S. The set-up works in double: S is a sum of four
+// angles minus 2 pi, which cancels badly in float for small rectangles. Below
+// kMinSphericalRectangleSolidAngle (or for a parallelogram that is not a
+// rectangle) the techniques fall back to area sampling, whose pdf is exact there.
+
+inline constexpr double kMinSphericalRectangleSolidAngle = 1e-7;
+
+struct SphericalRectangle {
+  bool usable = false;  // false: fall back to area sampling
+  double solid_angle = 0.0;
+  // Local frame: x along u, y along v, z towards the origin's side (flipped so z0 <= 0).
+  glm::dvec3 origin, x, y, z;
+  double x0, x1, y0, y1, z0;
+  double b0, b1, k;
+};
+
+inline bool quad_is_rectangle(const Quad& quad) {
+  return std::fabs(static_cast<double>(dot(quad.u, quad.v))) <=
+         1e-6 * static_cast<double>(length(quad.u)) * static_cast<double>(length(quad.v));
+}
+
+SphericalRectangle spherical_rectangle(const Quad& quad, const Vec3& origin);
+
+DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, float u1, float u2);
+float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction);
 
 }  // namespace pdflab
