@@ -1,0 +1,305 @@
+// Numbers at the extremes: weights of exactly 0 and 1, shading points in a
+// light's plane, on a light, inside a target sphere, grazing angles, tiny,
+// huge and distant lights, large coordinates; and no dropped samples on any
+// shipped scene.
+#include "renderer/error.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Rendered {
+  Film film;
+  SessionStats stats;
+};
+
+Rendered render(const std::shared_ptr<const Scene>& scene, const std::string& strategy, std::uint32_t spp,
+                std::uint64_t seed = 5, int threads = 2) {
+  RenderSession session(threads);
+  RenderSettings settings;
+  settings.scene = scene;
+  settings.strategy = Strategy::parse(strategy);
+  settings.seed = seed;
+  settings.target_spp = spp;
+  session.set_settings(settings);
+  session.wait_until_done();
+  return {session.copy_film(), session.stats()};
+}
+
+std::shared_ptr<Scene> load(const std::string& name, int width, int height) {
+  auto scene = std::make_shared<Scene>(load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + name));
+  scene->camera.width = width;
+  scene->camera.height = height;
+  scene->prepare();
+  return scene;
+}
+
+bool same_film(const Film& a, const Film& b) {
+  const auto x = a.mean_rgb(), y = b.mean_rgb();
+  return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+}
+
+// ---- Weights of exactly 0 and 1 ------------------------------------------------------
+
+TEST(Extremes, WeightOneIsTheTechniqueItself) {
+  // A mixture with weight 1 on a technique draws the same random numbers and
+  // the same directions with the same pdf: the images are bit-identical.
+  const auto scene = load("cornell_book.json", 24, 24);
+  EXPECT_TRUE(same_film(render(scene, "cosine", 4).film, render(scene, "mix:cosine=1,light=0", 4).film));
+  EXPECT_TRUE(same_film(render(scene, "light", 4).film, render(scene, "mix:cosine=0,light=1", 4).film));
+  EXPECT_TRUE(same_film(render(scene, "light-sa", 4).film, render(scene, "mix:light-sa=1,uniform-sphere=0", 4).film));
+  // And weights are normalised: 2:2 is 1:1.
+  EXPECT_TRUE(same_film(render(scene, "mix:cosine=0.5,light=0.5", 4).film, render(scene, "mix:cosine=2,light=2", 4).film));
+}
+
+// ---- Shading points in a light's plane, on it, inside a target sphere ------------------
+
+Quad unit_light() { return make_quad(Vec3(0, 10, 0), Vec3(1, 0, 0), Vec3(0, 0, 1), 0); }
+
+TEST(Extremes, PointInTheLightsPlaneOffersNoDirection) {
+  const Quad q = unit_light();
+  for (const Vec3 origin : {Vec3(-3, 10, 0.5f), Vec3(0.5f, 10, 0.5f) /* on the light itself */}) {
+    const DirectionSample a = sample_quad_area(q, origin, 0.3f, 0.6f);
+    EXPECT_TRUE(a.none);
+    EXPECT_EQ(a.pdf, 0.0f);
+    const DirectionSample s = sample_quad_solid_angle(q, origin, 0.3f, 0.6f);
+    EXPECT_TRUE(s.none);
+    // No direction from the plane reaches the quad: its density is zero everywhere.
+    for (const Vec3 d : {Vec3(1, 0, 0), normalize(Vec3(1, 1e-7f, 0)), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
+      EXPECT_EQ(quad_area_pdf(q, origin, d), 0.0f);
+      EXPECT_EQ(quad_solid_angle_pdf(q, origin, d), 0.0f);
+    }
+  }
+}
+
+TEST(Extremes, InsideATargetSphereEveryDirectionHasDensityOneOverFourPi) {
+  const Sphere s{Vec3(1, 2, 3), 2.0f, 0};
+  for (const Vec3 origin : {Vec3(1, 2, 3), Vec3(1.5f, 2, 3), Vec3(1, 3.999f, 3)}) {
+    Rng rng(3, 4);
+    for (int i = 0; i < 100; ++i) {
+      const DirectionSample ds = sample_sphere_cone(s, origin, rng.uniform(), rng.uniform());
+      EXPECT_NEAR(length(ds.direction), 1.0f, 1e-5f);
+      EXPECT_FLOAT_EQ(ds.pdf, 0.25f * kInvPi);
+      EXPECT_FLOAT_EQ(sphere_cone_pdf(s, origin, ds.direction), 0.25f * kInvPi);
+    }
+  }
+}
+
+TEST(Extremes, NoDroppedSamplesWhenShadingPointsLieInTheLightsPlane) {
+  // A floor in the plane of a two-sided light quad: every floor point is in
+  // the light's plane. The light is seen edge-on from all of them; nothing is
+  // dropped, and the floor stays unlit by direct light (only the wall lights it).
+  const std::string text = R"({
+    "camera": {"width": 16, "height": 16, "vfov": 60, "lookfrom": [0, 5, -10], "lookat": [0, 0, 0]},
+    "materials": {"white": {"type": "lambertian", "albedo": [0.7, 0.7, 0.7]},
+                  "lamp": {"type": "diffuse_light", "emit": [4, 4, 4], "two_sided": true}},
+    "objects": [
+      {"type": "quad", "q": [-5, 0, -5], "u": [10, 0, 0], "v": [0, 0, 10], "material": "white"},
+      {"type": "quad", "q": [-1, 0, 1], "u": [2, 0, 0], "v": [0, 0, 1], "material": "lamp"},
+      {"type": "quad", "q": [-5, 0, 5], "u": [10, 0, 0], "v": [0, 5, 0], "material": "white"}
+    ]})";
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "plane.json"));
+  for (const char* strategy : {"light", "light-sa", "mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light-sa=0.5", "nee-mis"}) {
+    const Rendered r = render(scene, strategy, 8);
+    EXPECT_EQ(r.stats.dropped.total(), 0u) << strategy;
+  }
+}
+
+// ---- Grazing angles ---------------------------------------------------------------
+
+TEST(Extremes, GrazingAnglesGiveFinitePositiveDensities) {
+  const Quad q = unit_light();
+  // A point 1e-7 above the light's plane, beside it: the light is seen at cos ~ 1e-7.
+  const Vec3 origin(-1.0f, 10.0f - 1e-6f, 0.5f);
+  for (float u : {0.01f, 0.5f, 0.99f}) {
+    const DirectionSample a = sample_quad_area(q, origin, u, 0.5f);
+    ASSERT_FALSE(a.none);
+    EXPECT_TRUE(std::isfinite(a.pdf) && a.pdf > 0.0f) << a.pdf;
+    const DirectionSample s = sample_quad_solid_angle(q, origin, u, 0.5f);  // falls back to area here
+    EXPECT_TRUE(std::isfinite(s.pdf) && s.pdf > 0.0f) << s.pdf;
+  }
+  // The cosine lobe at cos theta = 1e-7.
+  const Vec3 n(0, 0, 1);
+  const Vec3 grazing = normalize(Vec3(1.0f, 0.0f, 1e-7f));
+  EXPECT_GT(cosine_hemisphere_pdf(n, grazing), 0.0f);
+  EXPECT_NEAR(cosine_hemisphere_pdf(n, grazing), 1e-7f * kInvPi, 1e-9f);
+}
+
+// ---- Tiny, huge and distant lights ----------------------------------------------------
+
+// Solid angle of a w x h rectangle centred under a point at distance d.
+double centred_rectangle_solid_angle(double w, double h, double d) {
+  const double a = w / 2, b = h / 2;
+  return 4.0 * std::asin(a * b / std::sqrt((a * a + d * d) * (b * b + d * d)));
+}
+
+TEST(Extremes, SphericalRectangleMatchesTheAnalyticSolidAngle) {
+  for (const double size : {1e-2, 1.0, 10.0, 1e4}) {
+    const Quad q = make_quad(Vec3(-static_cast<float>(size / 2), 1, -static_cast<float>(size / 2)),
+                             Vec3(static_cast<float>(size), 0, 0), Vec3(0, 0, static_cast<float>(size)), 0);
+    const SphericalRectangle r = spherical_rectangle(q, Vec3(0, 0, 0));
+    ASSERT_TRUE(r.usable) << size;
+    EXPECT_NEAR(r.solid_angle / centred_rectangle_solid_angle(size, size, 1.0), 1.0, 1e-5) << size;
+  }
+}
+
+TEST(Extremes, TinyLightFallsBackToAreaSamplingConsistently) {
+  // 1e-4 units wide at distance 1: 1e-8 sr, below the spherical method's threshold.
+  const Quad q = make_quad(Vec3(-5e-5f, 1, -5e-5f), Vec3(1e-4f, 0, 0), Vec3(0, 0, 1e-4f), 0);
+  const Vec3 origin(0, 0, 0);
+  EXPECT_FALSE(spherical_rectangle(q, origin).usable);
+  Rng rng(8, 9);
+  for (int i = 0; i < 100; ++i) {
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const DirectionSample s = sample_quad_solid_angle(q, origin, u1, u2);
+    const DirectionSample a = sample_quad_area(q, origin, u1, u2);
+    EXPECT_EQ(s.direction, a.direction);
+    EXPECT_EQ(s.pdf, a.pdf);
+    EXPECT_TRUE(std::isfinite(s.pdf) && s.pdf > 0.0f);
+    EXPECT_NEAR(s.pdf, 1.0 / 1e-8, 1e-8 * 1e8 * 1e3);  // ~ 1 / solid angle
+  }
+}
+
+TEST(Extremes, HugeLightIsSampledUniformlyInSolidAngle) {
+  // 1e4 wide at distance 1: almost a hemisphere. Every sample lies on the
+  // light, has pdf 1/S, and the mean of the sample's cosine to the normal
+  // matches its analytic expectation (the light's projected solid angle / S).
+  const float half = 5e3f;
+  const Quad q = make_quad(Vec3(-half, 1, -half), Vec3(2 * half, 0, 0), Vec3(0, 0, 2 * half), 0);
+  const Vec3 origin(0, 0, 0);
+  const SphericalRectangle r = spherical_rectangle(q, origin);
+  ASSERT_TRUE(r.usable);
+  Rng rng(1, 2);
+  double sum_cos = 0.0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const DirectionSample s = sample_quad_solid_angle(q, origin, rng.uniform(), rng.uniform());
+    ASSERT_GT(quad_hit_distance(q, origin, s.direction), 0.0f);
+    ASSERT_FLOAT_EQ(s.pdf, static_cast<float>(1.0 / r.solid_angle));
+    sum_cos += s.direction.y;
+  }
+  // Projected solid angle of a large square seen from distance 1 is close to pi
+  // (pi for an infinite plane); computed here by fine quadrature in double.
+  double projected = 0.0;
+  const int m = 2000;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      // Quadrature over the square in tan-space keeps the far field accurate.
+      const double ta = std::atan(static_cast<double>(half));
+      const double ax = -ta + (i + 0.5) * 2 * ta / m, az = -ta + (j + 0.5) * 2 * ta / m;
+      const double x = std::tan(ax), z = std::tan(az);
+      const double jac = (1 + x * x) * (1 + z * z) * (2 * ta / m) * (2 * ta / m);
+      const double d2 = x * x + z * z + 1;
+      projected += jac / (d2 * d2);  // cos_at_origin * cos_at_light / d^2 with both cosines 1/sqrt(d2)
+    }
+  const double expected_mean_cos = projected / r.solid_angle;
+  const double se = std::sqrt(0.25 / n);  // cos in [0, 1]: variance at most 1/4
+  EXPECT_NEAR(sum_cos / n, expected_mean_cos, 5 * se);
+}
+
+TEST(Extremes, DistantSphereHasAStableConeAndPositiveDensity) {
+  const Sphere s{Vec3(0, 1e6f, 0), 1.0f, 0};
+  const Vec3 origin(0, 0, 0);
+  const SphereCone cone = sphere_cone(s, origin);
+  EXPECT_NEAR(cone.one_minus_cos_max / 5e-13, 1.0, 1e-4);  // r^2 / (2 d^2)
+  Rng rng(4, 4);
+  for (int i = 0; i < 1000; ++i) {
+    const DirectionSample ds = sample_sphere_cone(s, origin, rng.uniform(), rng.uniform());
+    EXPECT_TRUE(std::isfinite(ds.pdf) && ds.pdf > 0.0f);
+    EXPECT_GT(ds.direction.y, 0.99999f);
+  }
+}
+
+TEST(Extremes, DistantQuadLightOneMillionUnitsAway) {
+  const Quad q = make_quad(Vec3(-50, 1e6f, -50), Vec3(100, 0, 0), Vec3(0, 0, 100), 0);
+  const Vec3 origin(0, 0, 0);
+  const DirectionSample a = sample_quad_area(q, origin, 0.5f, 0.5f);
+  EXPECT_TRUE(std::isfinite(a.pdf) && a.pdf > 0.0f);
+  EXPECT_NEAR(a.pdf, 1e12 / 1e4, 1e8 * 1e-3);  // d^2 / A
+  const DirectionSample s = sample_quad_solid_angle(q, origin, 0.5f, 0.5f);
+  EXPECT_TRUE(std::isfinite(s.pdf) && s.pdf > 0.0f);
+  EXPECT_NEAR(s.pdf / a.pdf, 1.0, 1e-3);
+}
+
+// ---- Large coordinates: offsets avoid self-intersection, walls do not leak ------------
+
+TEST(Extremes, FurnaceAtLargeCoordinatesHasNoSelfIntersection) {
+  // A tilted lambertian floor of albedo 0.5 around y = 1e5 under a uniform sky
+  // of 2: with cosine sampling every floor pixel is exactly 1.0 unless a ray
+  // hits the floor it starts from. (Tilted, so that hit points round off the plane.)
+  const std::string text = R"({
+    "camera": {"width": 16, "height": 16, "vfov": 30, "lookfrom": [100000, 100050, 99900],
+               "lookat": [100000, 100000, 100000], "background": [2, 2, 2]},
+    "materials": {"grey": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [
+      {"type": "quad", "q": [99000, 99900, 101000], "u": [2000, 37, 0], "v": [0, 213, -2000], "material": "grey"}
+    ]})";
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "far.json"));
+  const Rendered r = render(scene, "cosine", 16);
+  for (std::size_t p = 0; p < r.film.pixel_count(); ++p) {
+    double m[3];
+    r.film.mean(p, m);
+    ASSERT_NEAR(m[0], 1.0, 1e-6) << "pixel " << p;
+  }
+}
+
+TEST(Extremes, ThinWallAtLargeCoordinatesDoesNotLeakLight) {
+  // A closed room around coordinates 1e5 whose ceiling is a wall 0.25 units
+  // thick; above it, a strong light facing down. Nothing may get inside.
+  const std::string text = R"({
+    "camera": {"width": 12, "height": 12, "vfov": 60, "lookfrom": [100000, 100002, 100000],
+               "lookat": [100000, 100000, 100003], "background": [0, 0, 0]},
+    "materials": {"white": {"type": "lambertian", "albedo": [0.9, 0.9, 0.9]},
+                  "lamp": {"type": "diffuse_light", "emit": [1000, 1000, 1000]}},
+    "objects": [
+      {"type": "box", "min": [99995, 99998, 99995], "max": [100005, 100004, 100005], "material": "white"},
+      {"type": "box", "min": [99990, 100004.05, 99990], "max": [100010, 100004.3, 100010], "material": "white"},
+      {"type": "quad", "q": [99994, 100004.6, 99994], "u": [12, 0, 0], "v": [0, 0, 12], "material": "lamp"}
+    ]})";
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "room.json"));
+  ASSERT_EQ(scene->quads.size(), 13u);
+  ASSERT_LT(scene->quads[12].normal.y, 0.0f);  // the lamp faces the room
+  for (const char* strategy : {"cosine", "mix:cosine=0.5,light=0.5", "nee-mis"}) {
+    const Rendered r = render(scene, strategy, 16);
+    for (std::size_t p = 0; p < r.film.pixel_count(); ++p) {
+      double m[3];
+      r.film.mean(p, m);
+      ASSERT_EQ(m[0] + m[1] + m[2], 0.0) << strategy << ": light leaked into pixel " << p;
+    }
+  }
+}
+
+// ---- Shipped scenes never drop a sample ------------------------------------------------
+
+TEST(Extremes, NoShippedSceneDropsASample) {
+  const char* strategies[] = {"cosine", "uniform-hemisphere", "uniform-sphere", "light", "light-sa",
+                              "mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light-sa=0.5", "nee-mis",
+                              "nee-mis:balance"};
+  int scenes = 0;
+  for (const auto& entry : fs::directory_iterator(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    ++scenes;
+    const auto scene = load(entry.path().filename().string(), 32, 32);
+    for (const char* strategy : strategies) {
+      const Rendered r = render(scene, strategy, 8);
+      EXPECT_EQ(r.stats.dropped.total(), 0u) << entry.path().filename() << " with " << strategy;
+    }
+  }
+  EXPECT_GE(scenes, 6);
+}
+
+}  // namespace
+}  // namespace pdflab
