@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -390,6 +391,28 @@ TEST(SamplingPlan, LightWithoutTargetsIsAnInputError) {
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), scene);
   EXPECT_EQ(plan.weight[static_cast<int>(Technique::Cosine)], 1.0f);
   EXPECT_EQ(plan.weight[static_cast<int>(Technique::Light)], 0.0f);
+}
+
+}  // namespace
+}  // namespace pdflab
+
+namespace pdflab {
+namespace {
+
+TEST(FastTrig, SinCos2PiMatchesLibmToFloatPrecision) {
+  double worst = 0.0;
+  for (int i = 0; i <= 1 << 20; ++i) {
+    const float u = static_cast<float>(i) / static_cast<float>(1 << 20);
+    float s, c;
+    sincos_2pi(u, s, c);
+    const double angle = 2.0 * std::numbers::pi * static_cast<double>(u);
+    worst = std::max({worst, std::fabs(s - std::sin(angle)), std::fabs(c - std::cos(angle))});
+  }
+  EXPECT_LT(worst, 1e-6);
+  float s, c;
+  sincos_2pi(0.0f, s, c);
+  EXPECT_EQ(c, 1.0f);
+  EXPECT_EQ(s, 0.0f);
 }
 
 }  // namespace

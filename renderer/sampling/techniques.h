@@ -27,9 +27,10 @@ inline constexpr float kInv4Pi = 0.25f * kInvPi;
 // Cosine-weighted hemisphere: p(w) = cos(theta) / pi.
 inline DirectionSample sample_cosine_hemisphere(const Onb& frame, float u1, float u2) {
   const float r = std::sqrt(u1);
-  const float phi = 2.0f * kPi * u2;
+  float sin_phi, cos_phi;
+  sincos_2pi(u2, sin_phi, cos_phi);
   const float z = std::sqrt(positive_part(1.0f - u1));
-  const Vec3 local(r * std::cos(phi), r * std::sin(phi), z);
+  const Vec3 local(r * cos_phi, r * sin_phi, z);
   return {frame.to_world(local), z * kInvPi};
 }
 inline float cosine_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
@@ -41,8 +42,9 @@ inline float cosine_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
 inline DirectionSample sample_uniform_hemisphere(const Onb& frame, float u1, float u2) {
   const float z = 1.0f - u1;  // (0, 1]: never exactly tangent
   const float r = std::sqrt(positive_part(1.0f - z * z));
-  const float phi = 2.0f * kPi * u2;
-  return {frame.to_world(Vec3(r * std::cos(phi), r * std::sin(phi), z)), kInv2Pi};
+  float sin_phi, cos_phi;
+  sincos_2pi(u2, sin_phi, cos_phi);
+  return {frame.to_world(Vec3(r * cos_phi, r * sin_phi, z)), kInv2Pi};
 }
 inline float uniform_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
   return dot(normal, direction) > 0.0f ? kInv2Pi : 0.0f;
@@ -52,8 +54,9 @@ inline float uniform_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
 inline DirectionSample sample_uniform_sphere(float u1, float u2) {
   const float z = 1.0f - 2.0f * u1;
   const float r = std::sqrt(positive_part(1.0f - z * z));
-  const float phi = 2.0f * kPi * u2;
-  return {Vec3(r * std::cos(phi), r * std::sin(phi), z), kInv4Pi};
+  float sin_phi, cos_phi;
+  sincos_2pi(u2, sin_phi, cos_phi);
+  return {Vec3(r * cos_phi, r * sin_phi, z), kInv4Pi};
 }
 inline float uniform_sphere_pdf() { return kInv4Pi; }
 
@@ -129,9 +132,10 @@ inline DirectionSample sample_sphere_cone(const Sphere& sphere, const Vec3& orig
   const float h = u1 * cone.one_minus_cos_max;  // 1 - cos(theta), uniform in [0, 1 - cos_max)
   const float cos_theta = 1.0f - h;
   const float sin_theta = std::sqrt(positive_part(h * (2.0f - h)));
-  const float phi = 2.0f * kPi * u2;
+  float sin_phi, cos_phi;
+  sincos_2pi(u2, sin_phi, cos_phi);
   const Onb frame(cone.axis);
-  const Vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
+  const Vec3 local(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
   return {normalize(frame.to_world(local)), 1.0f / (2.0f * kPi * cone.one_minus_cos_max)};
 }
 
