@@ -38,9 +38,10 @@ constexpr double kFamilyAlpha = 0.01;
 // 8 x 8 pixels pools 64 x spp paths per block (32768 at least) so that the
 // caustic reaches every block many times and block means are close to
 // normal; the uniform techniques, the heaviest-tailed and also the cheapest
-// (their paths die young), get 2x and 4x the samples. Measured over several
-// seeds, the block z-scores then have a variance up to about 1.15 (not 1) and
-// a most extreme value near -3.6 in 432. Standard errors are scaled by
+// (their paths die young), get 2x and 4x the samples. Measured over 3-4 seeds
+// per strategy (324-432 block-channels each), the unscaled block z-scores have
+// a variance of 0.96 to 1.17 (not 1) and reach -3.4 at worst (uniform-sphere
+// at 512 spp reached -3.6, hence its extra samples). Standard errors are scaled by
 // kHeavyTail = sqrt(1.2) to absorb that excess, and the Sidak-corrected
 // threshold (about 4.3 for 648 tests) keeps the family's false-alarm rate
 // near 1%.
