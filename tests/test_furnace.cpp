@@ -1,0 +1,245 @@
+// White furnace: a convex white lambertian sphere (albedo a) under a uniform
+// background B. Every path leaves the sphere after one bounce (it is convex),
+// so the exact image is a*B on the sphere and B around it, for every unbiased
+// strategy. Comparing per-pixel means with their standard errors catches any
+// estimator that is not unbiased: a pdf off by a constant, a mixture weight
+// not normalised, a sample whose pdf belongs to another direction.
+#include "renderer/film/film.h"
+#include "renderer/sampling/strategy.h"
+#include "renderer/scene/scene.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+#include "stats_util.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+namespace {
+
+constexpr double kAlbedo = 0.8;
+// A coloured background, so that a channel mixed up with another shows.
+const double kBackground[3] = {1.0, 0.5, 0.25};
+constexpr int kSide = 32;
+// 4096 samples per pixel: the sample variance then estimates the true one to
+// ~2%, so the per-pixel z-scores are as good as normal (a t distribution with
+// 4095 degrees of freedom) even at the corrected threshold near z = 5.
+constexpr std::uint32_t kSpp = 4096;
+// The renderer computes in float: a throughput of albedo * (cos/pi) / pdf is
+// exact only up to ~1e-7 relative, the same way in every sample, so it is a
+// bias no standard error covers. Differences this small are accepted.
+constexpr double kRounding = 1e-6;
+constexpr double kFamilyAlpha = 0.01;
+
+// The sphere is its own importance target: `light` from a point on it aims at
+// directions into the sphere, or (when rounding puts the point inside) at the
+// whole sphere; mixtures with a hemisphere technique stay unbiased either way.
+constexpr const char* kSceneJson = R"({
+  "name": "white furnace",
+  "camera": { "width": 32, "height": 32, "vfov": 30,
+              "lookfrom": [0, 0, 6], "lookat": [0, 0, 0], "vup": [0, 1, 0],
+              "max_depth": 50, "background": [1.0, 0.5, 0.25] },
+  "materials": { "white": { "type": "lambertian", "albedo": [0.8, 0.8, 0.8] } },
+  "objects": [ { "type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white",
+                 "importance": true } ]
+})";
+
+const std::vector<std::string>& unbiased_strategies() {
+  static const std::vector<std::string> s = {
+      "cosine",
+      "uniform-hemisphere",
+      "uniform-sphere",
+      "mix:cosine=0.5,light=0.5",
+      "mix:cosine=0.75,light=0.25",
+      "mix:uniform-hemisphere=0.5,light=0.5",
+      "mix:cosine=0.4,uniform-sphere=0.2,light=0.4",
+  };
+  return s;
+}
+
+std::shared_ptr<const Scene> furnace_scene() {
+  static const std::shared_ptr<const Scene> scene =
+      std::make_shared<const Scene>(load_scene_text(kSceneJson, "<furnace>"));
+  return scene;
+}
+
+Film render(const std::string& strategy, std::uint64_t seed) {
+  RenderSession session(2);
+  RenderSettings settings;
+  settings.scene = furnace_scene();
+  settings.strategy = Strategy::parse(strategy);
+  settings.seed = seed;
+  settings.target_spp = kSpp;
+  session.set_settings(settings);
+  EXPECT_TRUE(session.wait_until_done(std::chrono::seconds(120)));
+  EXPECT_EQ(session.stats().dropped.total(), 0u);
+  return session.copy_film();
+}
+
+enum class Coverage { Sphere, Background, Edge };
+
+// Which pixels lie wholly on the sphere or wholly off it. The directions that
+// hit a sphere form a convex cone, so a pixel whose four corner rays all hit it
+// lies wholly on it; one whose corner rays all pass more than a pixel's
+// footprint (about 0.1 at this distance) outside it lies wholly off it.
+Coverage coverage(const Scene& scene, int x, int y) {
+  const Sphere& s = scene.spheres[0];
+  int hits = 0, clear = 0;
+  for (int dy = 0; dy <= 1; ++dy)
+    for (int dx = 0; dx <= 1; ++dx) {
+      const Ray ray = scene.camera.generate_ray(static_cast<float>(x + dx), static_cast<float>(y + dy));
+      const Vec3 f = s.center - ray.origin;
+      const float miss_distance = length(cross(f, ray.direction));
+      if (miss_distance < 0.999f * s.radius) ++hits;
+      if (miss_distance > 1.2f * s.radius) ++clear;
+    }
+  return hits == 4 ? Coverage::Sphere : clear == 4 ? Coverage::Background : Coverage::Edge;
+}
+
+std::size_t pixel_index(int x, int y) { return static_cast<std::size_t>(y) * kSide + static_cast<std::size_t>(x); }
+
+struct FurnaceResult {
+  int sphere_pixels = 0, background_pixels = 0;
+  double worst_pixel_z = 0.0;     // largest |z| over sphere pixels and channels
+  double aggregate_z[3] = {};     // mean over all sphere pixels vs a*B, per channel
+  double aggregate_ratio[3] = {}; // that mean / (a*B)
+  int background_wrong = 0;       // background pixels not exactly B
+  int zero_variance_pixels = 0;
+};
+
+FurnaceResult analyse(const Film& film) {
+  const Scene& scene = *furnace_scene();
+  FurnaceResult r;
+  double sum_diff[3] = {}, sum_var[3] = {}, sum_mean[3] = {};
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x) {
+      const std::size_t p = pixel_index(x, y);
+      double mean[3], var[3];
+      film.mean(p, mean);
+      film.variance_of_mean(p, var);
+      switch (coverage(scene, x, y)) {
+        case Coverage::Background:
+          ++r.background_pixels;
+          // A camera ray that misses returns the background times a throughput of 1: exact.
+          for (int c = 0; c < 3; ++c)
+            if (std::fabs(mean[c] - kBackground[c]) > 1e-6 || var[c] != 0.0) ++r.background_wrong;
+          break;
+        case Coverage::Sphere: {
+          ++r.sphere_pixels;
+          bool all_zero = true;
+          for (int c = 0; c < 3; ++c) {
+            const double expected = kAlbedo * kBackground[c];
+            const double diff = mean[c] - expected;
+            const double beyond_rounding = std::max(0.0, std::fabs(diff) - kRounding * expected);
+            if (var[c] > 0.0) {
+              all_zero = false;
+              r.worst_pixel_z = std::max(r.worst_pixel_z, beyond_rounding / std::sqrt(var[c]));
+            } else if (beyond_rounding > 0.0) {
+              r.worst_pixel_z = INFINITY;  // no variance, yet not the exact answer
+            }
+            sum_diff[c] += diff;
+            sum_var[c] += var[c];
+            sum_mean[c] += mean[c];
+          }
+          if (all_zero) ++r.zero_variance_pixels;
+          break;
+        }
+        case Coverage::Edge: break;
+      }
+    }
+  for (int c = 0; c < 3; ++c) {
+    // Pixels use independent random streams: the variances of their means add.
+    const double exact = r.sphere_pixels * kAlbedo * kBackground[c];
+    const double beyond_rounding = std::copysign(std::max(0.0, std::fabs(sum_diff[c]) - kRounding * exact), sum_diff[c]);
+    r.aggregate_z[c] = beyond_rounding == 0.0 ? 0.0 : beyond_rounding / std::sqrt(sum_var[c]);
+    r.aggregate_ratio[c] = sum_mean[c] / exact;
+  }
+  return r;
+}
+
+// Per-pixel tests: every sphere pixel, every channel, every strategy.
+// Aggregate tests: one per channel and strategy.
+int per_pixel_tests() { return 3 * kSide * kSide * static_cast<int>(unbiased_strategies().size()); }
+int aggregate_tests() { return 3 * static_cast<int>(unbiased_strategies().size()); }
+
+class Furnace : public ::testing::TestWithParam<int> {};
+
+TEST_P(Furnace, SphereShowsAlbedoTimesBackground) {
+  const std::string& strategy = unbiased_strategies()[GetParam()];
+  const Film film = render(strategy, 17 + static_cast<std::uint64_t>(GetParam()));
+  const FurnaceResult r = analyse(film);
+  // Sidak over at most every pixel (an upper bound on the sphere pixels: conservative).
+  const double z_pixel = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, per_pixel_tests()));
+  const double z_total = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, aggregate_tests()));
+  std::printf("[furnace] %-45s worst pixel |z| %.2f (limit %.2f); aggregate z %+.2f %+.2f %+.2f (limit %.2f), "
+              "ratio %.5f; %d/%d sphere/background pixels\n",
+              strategy.c_str(), r.worst_pixel_z, z_pixel, r.aggregate_z[0], r.aggregate_z[1], r.aggregate_z[2],
+              z_total, r.aggregate_ratio[0], r.sphere_pixels, r.background_pixels);
+  ASSERT_GT(r.sphere_pixels, 150);
+  ASSERT_GT(r.background_pixels, 300);
+  EXPECT_EQ(r.background_wrong, 0) << "background pixels must be exactly B";
+  EXPECT_LT(r.worst_pixel_z, z_pixel);
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::fabs(r.aggregate_z[c]), z_total) << "channel " << c;
+  if (strategy != "cosine") {
+    // Only cosine sampling cancels the integrand exactly; every other
+    // strategy must show noise, or the per-pixel z-tests above were vacuous.
+    EXPECT_EQ(r.zero_variance_pixels, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Strategies, Furnace, ::testing::Range(0, static_cast<int>(unbiased_strategies().size())),
+                         [](const ::testing::TestParamInfo<int>& param_info) {
+                           std::string name = unbiased_strategies()[param_info.param];
+                           for (char& ch : name)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return name;
+                         });
+
+// Cosine sampling makes albedo * (cos/pi) / pdf = albedo for every sample: the
+// estimate is a*B with zero variance, up to float rounding (the cosine is
+// recomputed from the world-space direction, ~1e-7 relative).
+TEST(FurnaceCosine, ExactWithZeroVariance) {
+  const Film film = render("cosine", 5);
+  const Scene& scene = *furnace_scene();
+  int checked = 0;
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x) {
+      if (coverage(scene, x, y) != Coverage::Sphere) continue;
+      const std::size_t p = pixel_index(x, y);
+      double mean[3], var[3];
+      film.mean(p, mean);
+      film.variance_of_mean(p, var);
+      for (int c = 0; c < 3; ++c) {
+        const double expected = kAlbedo * kBackground[c];
+        EXPECT_NEAR(mean[c], expected, kRounding * expected) << x << "," << y;
+        EXPECT_LT(std::sqrt(var[c]), kRounding * expected) << x << "," << y;
+      }
+      ++checked;
+    }
+  EXPECT_GT(checked, 150);
+}
+
+// The furnace test can fail: pure `light` aims only at the sphere itself, i.e.
+// (mostly) into it, so it misses the background light a diffuse point sees.
+// Its image must be measurably darker than a*B.
+TEST(FurnaceLight, PureLightIsBiasedDark) {
+  const Film film = render("light", 3);
+  const FurnaceResult r = analyse(film);
+  const double z_total = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, aggregate_tests()));
+  std::printf("[furnace] light: aggregate z %+.2f, ratio %.4f\n", r.aggregate_z[0], r.aggregate_ratio[0]);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_LT(r.aggregate_z[c], -z_total) << "channel " << c;
+    EXPECT_LT(r.aggregate_ratio[c], 0.9) << "channel " << c;
+  }
+}
+
+}  // namespace
+}  // namespace pdflab
