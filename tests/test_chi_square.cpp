@@ -294,6 +294,8 @@ enum class Targets {
   TwoDisjoint,     // QuadOverhead plus a sphere off to the side, low
   BookLight,       // the book's light quad alone (scene scale ~500)
   Book,            // the book's scene: its light and its glass sphere
+  TwoPowers,       // two emitting quads overhead, one 40x the other's power
+  TwoLightsScene,  // assets/scenes/two_lights.json: a tiny bright light and a wide dim one
 };
 
 void add_quad_target(Scene& s, const Vec3& q, const Vec3& u, const Vec3& v) {
@@ -308,6 +310,8 @@ void add_sphere_target(Scene& s, const Vec3& c, float r) {
 std::unique_ptr<Scene> make_scene(Targets which) {
   if (which == Targets::Book)
     return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/cornell_book.json"));
+  if (which == Targets::TwoLightsScene)
+    return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/two_lights.json"));
   auto s = std::make_unique<Scene>();
   s->name = "chi-square targets";
   s->materials.push_back(Material{});
@@ -328,7 +332,21 @@ std::unique_ptr<Scene> make_scene(Targets which) {
       add_sphere_target(*s, {1.5f, 0.4f, 0.5f}, 0.35f);
       break;
     case Targets::BookLight: add_quad_target(*s, {213, 554, 227}, {130, 0, 0}, {0, 0, 105}); break;
-    case Targets::Book: break;
+    case Targets::TwoPowers: {
+      // Equal areas, emission 40 : 1, so power-proportional choice is 40 : 1.
+      Material bright, dim;
+      bright.type = dim.type = MaterialType::DiffuseLight;
+      bright.emit = Vec3(40.0f);
+      dim.emit = Vec3(1.0f);
+      s->materials = {bright, dim};
+      s->material_names = {"bright", "dim"};
+      add_quad_target(*s, {-1.2f, 1, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f});
+      add_quad_target(*s, {0.6f, 1, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f});
+      s->quads[1].material = 1;
+      break;
+    }
+    case Targets::Book:
+    case Targets::TwoLightsScene: break;
   }
   return s;
 }
@@ -339,6 +357,8 @@ struct ChiCase {
   Targets targets;
   Vec3 origin;
   Vec3 normal;  // normalised when the case runs
+  // Sample the plan's emitter set instead (the light technique of nee-mis).
+  bool emitter_set = false;
 };
 
 Vec3 unit(float x, float y, float z) { return normalize(Vec3(x, y, z)); }
@@ -395,6 +415,33 @@ const std::vector<ChiCase>& chi_cases() {
        {0, 0, 0}, unit(0.3f, 1, 0)},
       {"mix_hemisphere_light_unnormalised", "mix:uniform-hemisphere=3,light=1", Targets::Sphere, {0, 0, 0},
        unit(1, 1, 0)},
+      // light-sa: rectangles uniformly in solid angle, spheres by cone.
+      {"light_sa_quad_overhead", "light-sa", Targets::QuadOverhead, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_quad_off_centre_tilted", "light-sa", Targets::QuadOverhead, {0.8f, 0, 0.3f}, unit(1, 1, 0)},
+      {"light_sa_quad_close_wide", "light-sa", Targets::QuadOverhead, {0.1f, 0.97f, -0.2f}, {0, 1, 0}},
+      {"light_sa_quad_farther", "light-sa", Targets::QuadOverhead, {0, -2, 0}, {0, 1, 0}},
+      {"light_sa_quad_behind_surface", "light-sa", Targets::QuadOverhead, {0, 0, 0}, {0, -1, 0}},
+      {"light_sa_quad_grazing_near_horizon", "light-sa", Targets::QuadUpright, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_quad_grazing_straddles_horizon", "light-sa", Targets::QuadUpright, {0, 0.3f, 0}, {0, 1, 0}},
+      {"light_sa_quad_edge_on", "light-sa", Targets::QuadEdgeOn, {0, 0.2f, 0}, {0, 1, 0}},
+      {"light_sa_book_light_from_floor", "light-sa", Targets::BookLight, {278, 0, 279.5f}, {0, 1, 0}},
+      {"light_sa_book_light_from_ceiling_grazing", "light-sa", Targets::BookLight, {278, 555, 150}, {0, -1, 0}},
+      {"light_sa_sphere_overhead", "light-sa", Targets::Sphere, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_sphere_close", "light-sa", Targets::Sphere, {0.1f, 1.35f, 0}, {0, 1, 0}},
+      {"light_sa_sphere_farther", "light-sa", Targets::Sphere, {0, -1.5f, 0}, {0, 1, 0}},
+      {"light_sa_sphere_near_horizon", "light-sa", Targets::SphereHorizon, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_sphere_from_inside", "light-sa", Targets::Sphere, {0.1f, 2.1f, 0}, {0, 1, 0}},
+      {"light_sa_two_overlapping", "light-sa", Targets::TwoOverlapping, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_book", "light-sa", Targets::Book, {400, 0, 150}, {0, 1, 0}},
+      // Target choice by power: 40 : 1 between two equal quads, and the two-light scene.
+      {"light_sa_two_powers", "light-sa", Targets::TwoPowers, {0, 0, 0}, {0, 1, 0}},
+      {"light_sa_two_lights_scene", "light-sa", Targets::TwoLightsScene, {278, 0, 279.5f}, {0, 1, 0}},
+      {"mix_light_sa_025", "mix:cosine=0.75,light-sa=0.25", Targets::TwoDisjoint, {0, 0, 0}, {0, 1, 0}},
+      {"mix_light_sa_05_grazing", "mix:cosine=0.5,light-sa=0.5", Targets::QuadUpright, {0, 0.3f, 0}, {0, 1, 0}},
+      {"mix_light_and_light_sa", "mix:cosine=0.4,light=0.3,light-sa=0.3", Targets::TwoPowers, {0, 0, 0}, unit(0.2f, 1, 0)},
+      // The emitters that nee-mis samples (chosen by power, solid angle).
+      {"nee_emitters_two_powers", "nee-mis", Targets::TwoPowers, {0, 0, 0}, {0, 1, 0}, true},
+      {"nee_emitters_book", "nee-mis", Targets::Book, {400, 0, 150}, {0, 1, 0}, true},
   };
   return cases;
 }
@@ -418,11 +465,20 @@ PlanUnderTest bind(const ChiCase& c) {
   return p;
 }
 
+// The density under test: the plan's mixture, or its emitter set.
+double case_density(const ChiCase& c, const PlanUnderTest& p, const Vec3& d) {
+  return static_cast<double>(c.emitter_set ? p.plan.emitters.pdf(p.origin, d) : p.plan.pdf(p.origin, p.normal, d));
+}
+
 Outcome run_case(const ChiCase& c, std::uint64_t seed) {
   const PlanUnderTest p = bind(c);
   const Frame frame(p.normal);
-  auto density = [&](const Vec3& d) { return static_cast<double>(p.plan.pdf(p.origin, p.normal, d)); };
-  auto sampler = [&](Rng& rng) { return p.plan.sample(p.origin, p.normal, rng); };
+  auto density = [&](const Vec3& d) { return case_density(c, p, d); };
+  auto sampler = [&](Rng& rng) {
+    if (!c.emitter_set) return p.plan.sample(p.origin, p.normal, rng);
+    const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+    return p.plan.emitters.sample(p.origin, uc, u1, u2);
+  };
   return run_chi_square(frame, sampler, density, target_outlines(*p.scene, p.origin, frame), seed);
 }
 
@@ -459,7 +515,7 @@ TEST_P(ChiSquare, PdfIntegratesToOne) {
   const ChiCase& c = chi_cases()[GetParam()];
   const PlanUnderTest p = bind(c);
   const Frame frame(p.normal);
-  auto density = [&](const Vec3& d) { return static_cast<double>(p.plan.pdf(p.origin, p.normal, d)); };
+  auto density = [&](const Vec3& d) { return case_density(c, p, d); };
   const CellIntegrator integrator(frame, density, target_outlines(*p.scene, p.origin, frame));
   double total = 0.0;
   for (int cell = 0; cell < kCells; ++cell) total += integrator.integrate(cell);
@@ -555,6 +611,39 @@ TEST(ChiSquareDistribution, PoolsSmallCellsAndCountsImpossibleSamples) {
   EXPECT_EQ(r.zero_cell_hits, 0u);
   const std::vector<std::uint64_t> stray = {10, 12, 1, 2, 3, 4};
   EXPECT_EQ(stats::chi_square_test(stray, expected).zero_cell_hits, 4u);
+}
+
+}  // namespace
+}  // namespace pdflab
+
+namespace pdflab {
+namespace {
+
+// light-sa and nee-mis choose a target in proportion to its power; light
+// (the book's) uniformly. Counted directly: which quad does each sample reach?
+TEST(TargetChoice, ProportionalToPowerForLightSaUniformForLight) {
+  const std::unique_ptr<Scene> scene = make_scene(Targets::TwoPowers);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light-sa"), *scene);
+  ASSERT_EQ(plan.power_targets.quads.size(), 2u);
+  EXPECT_NEAR(plan.power_targets.quads[0].probability, 40.0 / 41.0, 1e-6);
+  EXPECT_NEAR(plan.book_targets.quads[0].probability, 0.5, 1e-6);
+  EXPECT_NEAR(plan.emitters.quads[0].probability, 40.0 / 41.0, 1e-6);
+
+  const Vec3 origin(0, 0, 0);
+  for (const auto& [set, expected] : {std::pair{&plan.power_targets, 40.0 / 41.0}, std::pair{&plan.book_targets, 0.5}}) {
+    Rng rng(77, 1);
+    const int n = 200000;
+    int bright = 0, dim = 0;
+    for (int i = 0; i < n; ++i) {
+      const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const DirectionSample ds = set->sample(origin, uc, u1, u2);
+      bright += quad_hit_distance(scene->quads[0], origin, ds.direction) > 0.0f;
+      dim += quad_hit_distance(scene->quads[1], origin, ds.direction) > 0.0f;
+    }
+    EXPECT_GE(bright + dim, n - 5);  // every sample reaches one of them (edge rounding aside)
+    const double se = std::sqrt(expected * (1.0 - expected) / n);
+    EXPECT_NEAR(static_cast<double>(bright) / n, expected, 5.0 * se);
+  }
 }
 
 }  // namespace
