@@ -9,7 +9,7 @@
 #include "renderer/sampling/techniques.h"
 #include "renderer/scene/scene.h"
 #include "renderer/scene/scene_loader.h"
-#include "stats_util.h"
+#include "renderer/metrics/statistics.h"
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>

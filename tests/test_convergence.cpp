@@ -8,7 +8,7 @@
 #include "renderer/scene/scene.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
-#include "stats_util.h"
+#include "renderer/metrics/statistics.h"
 
 #include <gtest/gtest.h>
 

@@ -298,12 +298,13 @@ float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& dire
   return p;
 }
 
-DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng) const {
+DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
   const float u0 = rng.uniform();
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
   int chosen = 0;
   while (u0 >= cdf[chosen]) ++chosen;
+  if (technique) *technique = chosen;
 
   DirectionSample ds;
   switch (static_cast<Technique>(chosen)) {

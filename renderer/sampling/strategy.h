@@ -103,7 +103,8 @@ struct SamplingPlan {
 
   // Draws a direction from the mixture and returns it with the mixture's pdf
   // sum_i w_i p_i(direction). `normal` faces the incoming ray's side.
-  DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng) const;
+  // `technique`, when given, receives which technique drew the direction.
+  DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr) const;
   // The mixture's pdf for any unit direction.
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
 

@@ -1,5 +1,6 @@
 #pragma once
-// Small statistics toolkit for the statistical tests: chi-square p-values
+// Small statistics toolkit for the statistical tests and the viewer's in-app
+// chi-square check: chi-square p-values
 // (regularised incomplete gamma), multiple-testing corrections and normal
 // quantiles. Double precision throughout; nothing here is on a hot path.
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "stats_util.h"
+#include "renderer/metrics/statistics.h"
 
 #include <algorithm>
 #include <cmath>

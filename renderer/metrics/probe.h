@@ -1,0 +1,57 @@
+#pragma once
+// The pixel probe: what the strategy does at the first diffuse surface a
+// pixel sees. Directions drawn there (with the technique that drew each), the
+// strategy's pdf as a map over the sphere of directions, and a chi-square
+// check of its sample/pdf pair at that very point.
+#include "renderer/metrics/statistics.h"
+#include "renderer/sampling/strategy.h"
+#include "renderer/scene/scene.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace pdflab {
+
+struct ProbePoint {
+  bool found = false;  // false: the pixel's ray left the scene or hit a light first
+  Vec3 point{0.0f}, normal{0.0f};  // normal faces the arriving ray
+  std::uint32_t material = 0;
+  int specular_bounces = 0;  // mirror/glass bounces before the diffuse hit
+};
+
+// Follows the ray through pixel centre (x, y) past metal and glass (glass
+// picks reflection or refraction with `seed`) to its first diffuse hit.
+ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t seed = 1);
+
+struct ProbeSample {
+  Vec3 direction;
+  float pdf;
+  int technique;  // Technique index, or -1 for an empty light sample
+};
+std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbePoint& at, int count,
+                                          std::uint64_t seed);
+
+// The pdf over the whole sphere of directions in a lat-long map around the
+// normal: column = azimuth phi in [0, 2 pi), row = cos(theta) from +1 (top,
+// the normal) to -1. `width` x `height` values, row-major.
+std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int width, int height);
+
+// Map coordinates (0..1) of a direction in pdf_map's layout.
+void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);
+
+// Chi-square test of plan.sample against plan.pdf at the probe point: samples
+// binned in `phi_cells` x `z_cells` equal-solid-angle cells over the sphere,
+// expected counts from the pdf integrated over each cell by supersampling.
+struct ProbeChiSquare {
+  stats::ChiSquareResult result;
+  bool passed = false;
+  double alpha = 0.01;
+  int z_cells = 0, phi_cells = 0;
+  std::vector<std::uint64_t> observed;  // per cell, row-major (z rows from +1 down)
+  std::vector<double> expected;
+  std::uint64_t empty_samples = 0;  // the technique had nothing to offer (a light seen edge-on)
+};
+ProbeChiSquare probe_chi_square(const SamplingPlan& plan, const ProbePoint& at, int samples, std::uint64_t seed,
+                                int z_cells = 16, int phi_cells = 32, double alpha = 0.01);
+
+}  // namespace pdflab

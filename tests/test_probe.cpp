@@ -1,0 +1,100 @@
+// The pixel probe: it finds the first diffuse surface behind a pixel, its
+// directions come from the techniques in proportion to their weights, and its
+// in-app chi-square check passes for every strategy at several pixels of the
+// book's scene (and fails when the pdf it is handed is wrong).
+#include "renderer/metrics/probe.h"
+#include "renderer/scene/scene_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pdflab {
+namespace {
+
+Scene book() {
+  Scene s = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/cornell_book.json");
+  s.camera.width = s.camera.height = 100;
+  s.prepare();
+  return s;
+}
+
+TEST(Probe, FindsTheFirstDiffuseSurface) {
+  const Scene s = book();
+  const ProbePoint floor = first_diffuse_hit(s, 50, 97);  // bottom centre: the floor
+  ASSERT_TRUE(floor.found);
+  EXPECT_NEAR(floor.point.y, 0.0f, 1e-2f);
+  EXPECT_NEAR(floor.normal.y, 1.0f, 1e-5f);
+  EXPECT_EQ(floor.specular_bounces, 0);
+  const ProbePoint ceiling = first_diffuse_hit(s, 50, 10);
+  ASSERT_TRUE(ceiling.found);
+  EXPECT_NEAR(ceiling.point.y, 555.0f, 1e-2f);
+  EXPECT_NEAR(ceiling.normal.y, -1.0f, 1e-5f);
+  const ProbePoint through_glass = first_diffuse_hit(s, 70, 85);  // the glass sphere, lower right
+  ASSERT_TRUE(through_glass.found);
+  EXPECT_GE(through_glass.specular_bounces, 1);
+}
+
+TEST(Probe, DirectionsComeFromTheTechniquesInProportionToTheirWeights) {
+  const Scene s = book();
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.25,light=0.75"), s);
+  const ProbePoint at = first_diffuse_hit(s, 50, 97);
+  const auto dirs = probe_directions(plan, at, 4000, 3);
+  ASSERT_EQ(dirs.size(), 4000u);
+  int light = 0;
+  for (const auto& d : dirs) light += d.technique == static_cast<int>(Technique::Light);
+  EXPECT_NEAR(light / 4000.0, 0.75, 5 * std::sqrt(0.75 * 0.25 / 4000));
+}
+
+TEST(Probe, ChiSquareCheckPassesForEveryStrategy) {
+  const Scene s = book();
+  const char* strategies[] = {"cosine", "uniform-hemisphere", "uniform-sphere", "light", "light-sa",
+                              "mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light-sa=0.5"};
+  const int pixels[][2] = {{50, 97}, {5, 50}, {95, 50}, {50, 60}};
+  int checks = 0;
+  for (const auto& px : pixels) {
+    const ProbePoint at = first_diffuse_hit(s, px[0], px[1]);
+    ASSERT_TRUE(at.found);
+    for (const char* st : strategies) {
+      const SamplingPlan plan = SamplingPlan::make(Strategy::parse(st), s);
+      // alpha 1e-4 per check: 28 checks keep the family's false alarms below 0.3%.
+      const ProbeChiSquare c = probe_chi_square(plan, at, 20000, 11, 16, 32, 1e-4);
+      EXPECT_TRUE(c.passed) << st << " at pixel " << px[0] << "," << px[1] << ": p " << c.result.p_value
+                            << ", zero-cell hits " << c.result.zero_cell_hits;
+      ++checks;
+    }
+  }
+  EXPECT_EQ(checks, 28);
+}
+
+TEST(Probe, ChiSquareCheckFailsWhenThePdfDisagreesWithTheSampler) {
+  const Scene s = book();
+  SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), s);
+  // The sampler still picks techniques by the CDF (50/50); the pdf now claims 70/30.
+  plan.weight[static_cast<int>(Technique::Cosine)] = 0.7f;
+  plan.weight[static_cast<int>(Technique::Light)] = 0.3f;
+  const ProbeChiSquare c = probe_chi_square(plan, first_diffuse_hit(s, 50, 97), 20000, 11);
+  EXPECT_FALSE(c.passed) << "p " << c.result.p_value;
+  EXPECT_LT(c.result.p_value, 1e-6);
+}
+
+TEST(Probe, PdfMapShowsTheLightAboveTheFloor) {
+  const Scene s = book();
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light"), s);
+  const ProbePoint at = first_diffuse_hit(s, 50, 97);
+  const int w = 256, h = 128;
+  const auto map = pdf_map(plan, at, w, h);
+  // Towards the light's centre the map shows the light's density.
+  const Vec3 to_light = normalize(Vec3(278, 554, 279.5f) - at.point);
+  float u, v;
+  direction_to_map(at, to_light, u, v);
+  const std::size_t at_light = static_cast<std::size_t>(v * h) * w + static_cast<std::size_t>(u * w);
+  EXPECT_NEAR(map[at_light], plan.pdf(at.point, at.normal, to_light), 0.05f * map[at_light] + 1e-3f);
+  EXPECT_GT(map[at_light], 0.0f);
+  // Below the floor (the lower half of the map) the light pdf is zero.
+  for (int r = h / 2; r < h; ++r)
+    for (int c = 0; c < w; ++c) ASSERT_EQ(map[static_cast<std::size_t>(r) * w + c], 0.0f) << r << "," << c;
+}
+
+}  // namespace
+}  // namespace pdflab
