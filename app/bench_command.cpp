@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -27,6 +28,7 @@ struct Result {
   Strategy strategy;
   std::uint32_t spp = 0;
   double seconds = 0, rmse = 0, relmse = 0, efficiency = 0, samples_per_second = 0;
+  double estimated_relmse = 0;  // the film's own prediction, for comparison with the measured relmse
   std::uint64_t dropped = 0;
   std::vector<Checkpoint> curve;
 };
@@ -89,6 +91,7 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   r.rmse = rmse(final_image, reference);
   r.relmse = relmse(final_image, reference);
   r.efficiency = efficiency(r.relmse, r.seconds);
+  r.estimated_relmse = estimated_relmse(film);
   r.samples_per_second = st.samples_per_second;
   r.dropped = st.dropped.total();
   if (r.curve.empty() || r.curve.back().spp != r.spp) r.curve.push_back({r.spp, r.seconds, r.rmse, r.relmse});
@@ -97,23 +100,47 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
 
 }  // namespace
 
+// A reference with NaN or infinity would turn every error into NaN and rank
+// the strategies at random; say where the first bad value is instead.
+void check_reference(const std::string& path, const std::vector<float>& rgb, int width) {
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < rgb.size(); ++i)
+    if (!std::isfinite(rgb[i]) && bad++ == 0) first = i;
+  if (bad == 0) return;
+  const std::size_t pixel = first / 3, w = static_cast<std::size_t>(width);
+  throw InputError("reference '" + path + "' has " + std::to_string(bad) + " values that are not finite (first at pixel " +
+                   std::to_string(pixel % w) + "," + std::to_string(pixel / w) + ")");
+}
+
 int run_bench(const BenchOptions& o) {
+  if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
+    throw InputError("--seconds must be a positive number of seconds");
   if ((o.seconds > 0) == (o.spp > 0)) throw InputError("give exactly one of --seconds (equal time) and --spp (equal samples)");
-  if (o.seconds < 0 || !std::isfinite(o.seconds)) throw InputError("--seconds must be a positive number");
   if (o.threads < 0) throw InputError("--threads must be >= 0");
   check_output_path(o.csv);
   if (!o.plot.empty()) check_output_path(o.plot);
   if (!o.curves.empty()) check_output_path(o.curves);
+  // Two outputs on one path would silently keep only the last one written.
+  if (o.csv == o.plot || o.csv == o.curves || (!o.plot.empty() && o.plot == o.curves))
+    throw InputError("--csv, --plot and --curves must name different files");
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
   int rw = 0, rh = 0;
   const std::vector<float> reference = read_pfm(o.reference, rw, rh);
+  check_reference(o.reference, reference, rw);
   scene->camera.width = rw;
   scene->camera.height = rh;
   scene->prepare();
 
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
+  if (!o.quiet)
+    for (const Strategy& s : strategies)
+      if (!s.is_unbiased())
+        std::fprintf(stderr,
+                     "note: strategy '%s' is biased (it omits indirect light): its error against the reference "
+                     "stops falling with time\n",
+                     s.to_string().c_str());
   std::vector<Result> results;
   for (std::size_t i = 0; i < strategies.size(); ++i) {
     const std::string prefix = "[" + std::to_string(i + 1) + "/" + std::to_string(strategies.size()) + "]";
@@ -121,25 +148,30 @@ int run_bench(const BenchOptions& o) {
   }
   if (show_progress) std::fputc('\n', stderr);
 
-  std::string csv = "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped\n";
+  // Every text is built before the first is written, so only an I/O failure
+  // can leave one file without the others.
+  // est_relmse: what the film predicts without a reference; unbiased: 0 for a
+  // strategy whose pdf misses directions the integrand needs.
+  std::string csv = "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased\n";
   char line[512];
   for (const Result& r : results) {
-    std::snprintf(line, sizeof line, ",%u,%.4f,%.6g,%.6g,%.6g,%.6g,%llu\n", r.spp, r.seconds, r.rmse, r.relmse,
-                  r.efficiency, r.samples_per_second, static_cast<unsigned long long>(r.dropped));
+    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d\n", r.spp, r.seconds, r.rmse, r.relmse,
+                  r.efficiency, r.samples_per_second, static_cast<unsigned long long>(r.dropped), r.estimated_relmse,
+                  r.strategy.is_unbiased() ? 1 : 0);
     csv += csv_field(r.strategy.to_string()) + line;
   }
-  write_text(o.csv, csv);
 
+  std::string curves;
   if (!o.curves.empty()) {
-    std::string c = "strategy,spp,seconds,rmse,relmse\n";
+    curves = "strategy,spp,seconds,rmse,relmse\n";
     for (const Result& r : results)
       for (const Checkpoint& k : r.curve) {
-        std::snprintf(line, sizeof line, ",%u,%.4f,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse);
-        c += csv_field(r.strategy.to_string()) + line;
+        std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse);
+        curves += csv_field(r.strategy.to_string()) + line;
       }
-    write_text(o.curves, c);
   }
 
+  std::string plot;
   if (!o.plot.empty()) {
     std::vector<PlotSeries> series;
     for (const Result& r : results) {
@@ -159,19 +191,24 @@ int run_bench(const BenchOptions& o) {
     po.guide_label = "1/sqrt(N)";
     po.width = 900;
     po.height = 520;
-    write_text(o.plot, loglog_svg(series, po));
+    plot = loglog_svg(series, po);
   }
+  write_text(o.csv, csv);
+  if (!o.curves.empty()) write_text(o.curves, curves);
+  if (!o.plot.empty()) write_text(o.plot, plot);
 
   // The table: efficiency relative to the first strategy says which PDF wins.
-  std::printf("%-36s %7s %8s %10s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse", "relmse",
-              "efficiency", "vs first", "Msamp/s", "dropped");
+  std::printf("%-36s %7s %8s %10s %10s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse", "relmse",
+              "est relmse", "efficiency", "vs first", "Msamp/s", "dropped");
   for (const Result& r : results) {
     const double ratio = results[0].efficiency > 0 ? r.efficiency / results[0].efficiency : 0.0;
-    std::printf("%-36s %7u %8.2f %10.4g %10.4g %11.4g %7.2fx %9.3f %8llu%s\n", r.strategy.to_string().c_str(), r.spp,
-                r.seconds, r.rmse, r.relmse, r.efficiency, ratio, r.samples_per_second * 1e-6,
+    std::printf("%-36s %7u %8.2f %10.4g %10.4g %10.4g %11.4g %7.2fx %9.3f %8llu%s\n", r.strategy.to_string().c_str(),
+                r.spp, r.seconds, r.rmse, r.relmse, r.estimated_relmse, r.efficiency, ratio, r.samples_per_second * 1e-6,
                 static_cast<unsigned long long>(r.dropped), r.strategy.is_unbiased() ? "" : "  (biased)");
   }
-  std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e); efficiency = 1 / (relMSE * seconds)\n", kRelMseEpsilon);
+  std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e); efficiency = 1 / (relMSE * seconds); est relmse: the "
+              "film's own prediction, no reference\n",
+              kRelMseEpsilon);
   return 0;
 }
 

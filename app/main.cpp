@@ -6,7 +6,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 
@@ -60,7 +62,18 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "Compare strategies at equal time (or spp) against a reference");
   bench->add_option("--scene", bo.scene, "Scene file (JSON)")->required();
   bench->add_option("--strategies", bo.strategies, "Strategies separated by ';'")->required();
-  bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")->check(CLI::PositiveNumber);
+  // CLI::PositiveNumber would print DBL_MAX in its message and let "nan" through to the
+  // "exactly one of" check; say plainly what is wrong instead.
+  bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0)
+              return "must be a positive number of seconds, not '" + text + "'";
+            return std::string();
+          },
+          "SECONDS"));
   bench->add_option("--spp", bo.spp, "Samples per pixel per strategy (equal samples)")->check(CLI::Range(1u, 1u << 30));
   bench->add_option("--reference", bo.reference, "Reference image (PFM; its size sets the render size)")->required();
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();

@@ -21,9 +21,14 @@ double relmse(const std::vector<float>& image, const std::vector<float>& referen
 // render time for an unbiased estimator whose error falls as 1/N.
 double efficiency(double relmse_value, double seconds);
 
-// The film's own estimate of its noise, no reference needed: per pixel the
-// standard error of the mean luminance divided by (mean luminance + epsilon),
-// averaged over pixels with at least two samples.
+// The film's own estimate of its noise, no reference needed: per pixel
+// sqrt(luminance of the per-channel variances of the mean) over (mean
+// luminance + epsilon), averaged over pixels with at least two samples. The
+// film keeps no luminance sum of squares, so for coloured samples this bounds
+// the standard error of the mean luminance from above (Cauchy-Schwarz, then
+// Jensen with weights summing to 1); for grey samples it is equal.
+// Like any sample variance it cannot see what the samples missed: a pixel whose
+// few samples never found a small light reports little noise.
 double mean_relative_standard_error(const Film& film, double epsilon = kRelMseEpsilon);
 
 // The film's estimate of the relMSE it would have against the true image: the

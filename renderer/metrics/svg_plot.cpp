@@ -47,7 +47,11 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
   const double lx0 = std::floor(std::log10(x0)), lx1 = std::max(lx0 + 1.0, std::ceil(std::log10(x1)));
   const double ly0 = std::floor(std::log10(y0)), ly1 = std::max(ly0 + 1.0, std::ceil(std::log10(y1)));
 
-  const double left = 80, right = 200, top = 40, bottom = 60;
+  // The legend sits right of the plot; long mixture names must fit inside the
+  // picture (about 7 px a character at 12 px sans-serif).
+  std::size_t longest = o.guide_label.size();
+  for (const auto& s : series) longest = std::max(longest, s.label.size());
+  const double left = 80, right = std::max(200.0, 60.0 + 7.0 * static_cast<double>(longest)), top = 40, bottom = 60;
   const double pw = o.width - left - right, ph = o.height - top - bottom;
   auto px = [&](double x) { return left + (std::log10(x) - lx0) / (lx1 - lx0) * pw; };
   auto py = [&](double y) { return top + (ly1 - std::log10(y)) / (ly1 - ly0) * ph; };
@@ -91,12 +95,16 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
   for (std::size_t k = 0; k < series.size(); ++k) {
     const auto& s = series[k];
     const std::string colour = kColours[k % (sizeof kColours / sizeof kColours[0])];
-    std::string points;
+    std::string points, last;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (!(s.x[i] > 0.0) || !(s.y[i] > 0.0) || !std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      last = "cx=\"" + fmt("%.1f", px(s.x[i])) + "\" cy=\"" + fmt("%.1f", py(s.y[i])) + "\"";
       points += fmt("%.1f", px(s.x[i])) + "," + fmt("%.1f", py(s.y[i])) + " ";
     }
     svg += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\" points=\"" + points + "\"/>\n";
+    // A line of one point draws nothing; the end marker also shows where each
+    // strategy stopped, which is what an equal-time comparison reads off.
+    if (!last.empty()) svg += "<circle " + last + " r=\"3.5\" fill=\"" + colour + "\"/>\n";
     legend(colour, s.label, false);
   }
 
