@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab render --help' for usage.\n", e.what());
+    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab COMMAND --help' for usage.\n", e.what());
     return kBadInput;
   }
 
