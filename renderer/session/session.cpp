@@ -78,13 +78,11 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
 int RenderSession::preview_scale_locked() const {
   const Camera& cam = settings_.scene->camera;
   const double pixels = static_cast<double>(cam.width) * cam.height;
-  double scale = 1.0;
-  if (full_samples_per_second_ > 0.0) {
-    const double budget_samples = full_samples_per_second_ * options_.preview_budget_ms * 1e-3;
-    scale = std::ceil(std::sqrt(pixels / std::max(1.0, budget_samples)));
-  } else if (pixels >= 128.0 * 128.0) {
-    scale = 4.0;  // nothing measured yet: a sixteenth of a pass is a safe first guess
-  }
+  // Nothing measured yet: guess a modest half a million samples a second per
+  // worker (deep paths in the book's scene); the first full pass corrects it.
+  const double rate = full_samples_per_second_ > 0.0 ? full_samples_per_second_ : 5e5 * static_cast<double>(workers_.size());
+  const double budget_samples = rate * options_.preview_budget_ms * 1e-3;
+  const double scale = std::ceil(std::sqrt(pixels / std::max(1.0, budget_samples)));
   return static_cast<int>(std::clamp(scale, 1.0, 16.0));
 }
 
