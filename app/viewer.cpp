@@ -28,6 +28,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include <time.h>
+
 #ifndef PDFLAB_VERSION
 #define PDFLAB_VERSION "unknown"
 #endif
@@ -64,6 +66,12 @@ void glfw_error(int code, const char* message) { std::fprintf(stderr, "pdflab: G
 std::string default_screenshot_dir() {
   if (const char* env = std::getenv("PDFLAB_SCREENSHOT_DIR"); env && *env) return env;
   return "screenshots";
+}
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 }  // namespace
@@ -475,10 +483,11 @@ Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
 
 Viewer::~Viewer() { impl_->close(); }
 
-bool Viewer::frame(bool paced) {
+bool Viewer::frame(bool paced, bool force_draw) {
   Impl& v = *impl_;
   if (glfwWindowShouldClose(v.window)) return false;
   const auto t0 = Clock::now();
+  const double cpu0 = thread_cpu_ms();
   v.report.new_image = false;
   v.report.drawn = false;
   glfwPollEvents();
@@ -501,7 +510,7 @@ bool Viewer::frame(bool paced) {
     v.settle_frames = 3;
   }
   // Elapsed time and samples/s tick between images: a few redraws a second show that.
-  const bool draw = v.texture_stale || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
+  const bool draw = force_draw || v.texture_stale || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
                     t0 - v.last_draw > std::chrono::milliseconds(250);
   if (!draw) {
     if (paced) glfwWaitEventsTimeout(kFramePeriod);
@@ -555,6 +564,7 @@ bool Viewer::frame(bool paced) {
 
   const auto t1 = Clock::now();
   v.report.work_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  v.report.cpu_ms = thread_cpu_ms() - cpu0;
   v.report.drawn = true;
   v.report.shown_generation = v.image_info.generation;
   v.report.shown_preview = v.image_info.preview;

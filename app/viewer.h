@@ -31,12 +31,14 @@ class Viewer {
   Viewer& operator=(const Viewer&) = delete;
 
   // Handles input, shows the newest image, draws the UI. False once the window
-  // should close. Sleeps to pace itself unless `paced` is false.
-  bool frame(bool paced = true);
+  // should close. Sleeps to pace itself unless `paced` is false. Draws only when
+  // something visible changed unless `force_draw` (benchmarks: a user dragging a slider).
+  bool frame(bool paced = true, bool force_draw = false);
   int run();
 
   struct FrameReport {
     double work_ms = 0.0;               // from the frame's start to the swap returning
+    double cpu_ms = 0.0;                // the UI thread's CPU time in that span (not llvmpipe's threads)
     std::uint64_t shown_generation = 0; // settings generation of the image on screen
     bool shown_preview = false;
     std::uint32_t shown_spp = 0;

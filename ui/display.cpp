@@ -70,17 +70,21 @@ bool ImageDisplay::init(std::string& error) {
   glGenVertexArrays(1, &vao_);
   glGenTextures(1, &texture_);
   glBindTexture(GL_TEXTURE_2D, texture_);
-  // Minifying smooths; magnifying keeps pixels square, since a pixel's noise is
-  // exactly what one looks at in a sampling lab.
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  // Read texel for texel by the tone-mapping pass: no filtering.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+
+  glGenTextures(1, &mapped_texture_);
+  glGenFramebuffers(1, &mapped_fbo_);
   return true;
 }
 
 ImageDisplay::~ImageDisplay() {
   // Only valid while the context lives; the viewer destroys us before it.
+  if (mapped_fbo_) glDeleteFramebuffers(1, &mapped_fbo_);
+  if (mapped_texture_) glDeleteTextures(1, &mapped_texture_);
   if (texture_) glDeleteTextures(1, &texture_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
   if (program_) glDeleteProgram(program_);
@@ -93,14 +97,21 @@ void ImageDisplay::upload(const float* rgb, int width, int height) {
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, width, height, 0, GL_RGB, GL_FLOAT, rgb);
     width_ = width;
     height_ = height;
+    glBindTexture(GL_TEXTURE_2D, mapped_texture_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glBindFramebuffer(GL_FRAMEBUFFER, mapped_fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, mapped_texture_, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
   } else {
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGB, GL_FLOAT, rgb);
   }
+  mapped_stale_ = true;
 }
 
-void ImageDisplay::draw(const Viewport& where, float exposure_ev, bool srgb) const {
-  if (!has_image() || where.width <= 0 || where.height <= 0) return;
-  glViewport(where.x, where.y, where.width, where.height);
+void ImageDisplay::tone_map(float exposure_ev, bool srgb) {
+  glBindFramebuffer(GL_FRAMEBUFFER, mapped_fbo_);
+  glViewport(0, 0, width_, height_);
+  glDisable(GL_BLEND);
   glUseProgram(program_);
   glUniform1f(exposure_location_, std::exp2(exposure_ev));
   glUniform1i(transfer_location_, srgb ? 1 : 0);
@@ -111,6 +122,22 @@ void ImageDisplay::draw(const Viewport& where, float exposure_ev, bool srgb) con
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
   glUseProgram(0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  mapped_stale_ = false;
+  mapped_exposure_ = exposure_ev;
+  mapped_srgb_ = srgb;
+}
+
+void ImageDisplay::draw(const Viewport& where, float exposure_ev, bool srgb) {
+  if (!has_image() || where.width <= 0 || where.height <= 0) return;
+  if (mapped_stale_ || exposure_ev != mapped_exposure_ || srgb != mapped_srgb_) tone_map(exposure_ev, srgb);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, mapped_fbo_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  // Shrinking averages; enlarging keeps pixels square (their noise is the point).
+  const bool shrinking = where.width < width_ || where.height < height_;
+  glBlitFramebuffer(0, 0, width_, height_, where.x, where.y, where.x + where.width, where.y + where.height,
+                    GL_COLOR_BUFFER_BIT, shrinking ? GL_LINEAR : GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 }  // namespace pdflab::ui
