@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <future>
@@ -167,12 +168,19 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   SessionOptions so;
   so.background_priority = true;
   so.preview = true;
+  // A new image ends the wait between frames at once instead of at the next tick.
+  so.on_image = [] { glfwPostEmptyEvent(); };
   session = std::make_unique<RenderSession>(so);
   if (!apply_render_settings()) throw InputError(status.settings_error);
 }
 
 void Viewer::Impl::open_window(int image_width, int image_height) {
   glfwSetErrorCallback(glfw_error);
+  // Under Mesa's software rasteriser (llvmpipe: Xvfb, VMs, remote desktops) its
+  // own rasteriser threads would fight the render workers for every core and
+  // hand each frame across threads; drawing on the UI thread halves the frame
+  // time there (bench_viewer). Ignored by hardware drivers; a user's value wins.
+  ::setenv("LP_NUM_THREADS", "0", 0);
   if (!glfwInit()) throw std::runtime_error("cannot open a window (no display? try xvfb-run, or `pdflab render`)");
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -273,7 +281,6 @@ void Viewer::Impl::rebuild_fonts() {
   style.FrameRounding = 3.0f;
   style.GrabRounding = 3.0f;
   style.WindowBorderSize = 0.0f;
-  style.Colors[ImGuiCol_WindowBg].w = 0.97f;
   style.ScaleAllSizes(content_scale / framebuffer_scale);
 }
 
@@ -552,9 +559,14 @@ bool Viewer::frame(bool paced, bool force_draw) {
   }
 
   glViewport(0, 0, fb_w, fb_h);
-  glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+  glClearColor(0.05f, 0.05f, 0.055f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
   const int panel_px = static_cast<int>(panel_width * v.framebuffer_scale);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(fb_w - panel_px, 0, panel_px, fb_h);
+  glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glDisable(GL_SCISSOR_TEST);
   const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
   v.display->draw(ui::fit_image(area, v.display->width(), v.display->height()), v.settings.exposure_ev,
                   v.settings.srgb);

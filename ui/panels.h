@@ -5,6 +5,10 @@
 
 namespace pdflab::ui {
 
+// Background of the side panel as RGB: the panel draws none, the viewer
+// clears the panel's rectangle to it.
+inline constexpr float kPanelBackground[3] = {0.11f, 0.11f, 0.125f};
+
 // The side panel, `width` wide at the right edge of a display `display_height` high
 // (ImGui coordinates).
 void draw_side_panel(float width, float display_height, ViewerSettings& settings, PanelState& state,

@@ -188,12 +188,15 @@ void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
   info.seconds = elapsed_locked();
   info.preview = pass.preview;
   // The UI thread only ever takes image_mutex_, never mutex_.
-  std::lock_guard ik(image_mutex_);
-  image_.swap(rgb);
-  image_width_ = info.width;
-  image_height_ = info.height;
-  image_info_ = info;
-  ++image_version_;
+  {
+    std::lock_guard ik(image_mutex_);
+    image_.swap(rgb);
+    image_width_ = info.width;
+    image_height_ = info.height;
+    image_info_ = info;
+    ++image_version_;
+  }
+  if (options_.on_image) options_.on_image();
 }
 
 void RenderSession::worker_main() {

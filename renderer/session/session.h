@@ -13,6 +13,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -56,7 +57,10 @@ struct SessionOptions {
   // After each change, render one cheap reduced-resolution pass first (never
   // summed into the film) so the first image of new settings appears quickly.
   bool preview = false;
-  double preview_budget_ms = 15.0;  // aimed duration of the preview pass
+  double preview_budget_ms = 10.0;  // aimed duration of the preview pass
+  // Called by a worker right after each new image is published (a viewer wakes
+  // its event loop with it). Must be cheap and safe to call from any thread.
+  std::function<void()> on_image;
 };
 
 class RenderSession {
