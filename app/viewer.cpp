@@ -193,9 +193,10 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   const float scale = std::clamp(std::max(xs, ys), 0.5f, 4.0f);
   int width = options.window_width, height = options.window_height;
   if (width <= 0 || height <= 0) {
-    // The image at one image pixel per screen pixel, within reason, plus the panel.
-    const int image_w = std::clamp(image_width, 320, 1000);
-    const int image_h = std::clamp(image_height, 320, 1000);
+    // The image at one image pixel per screen pixel (per `scale` on HiDPI
+    // screens, like everything else), within reason, plus the panel.
+    const int image_w = static_cast<int>(static_cast<float>(std::clamp(image_width, 320, 1000)) * scale);
+    const int image_h = static_cast<int>(static_cast<float>(std::clamp(image_height, 320, 1000)) * scale);
     width = image_w + static_cast<int>(kPanelWidth * scale);
     height = std::max(image_h, static_cast<int>(800.0f * scale));
     if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
