@@ -598,7 +598,14 @@ bool Viewer::frame(bool paced, bool force_draw) {
 int Viewer::run() {
   while (frame()) {
   }
-  return impl_->exit_status;
+  Impl& v = *impl_;
+  if (v.cli_mode() && !v.cli_done) {
+    // Closed before the image was complete: say so, and don't report success.
+    std::fprintf(stderr, "pdflab: error: the window was closed before %u spp; %s was not written\n", v.options.spp,
+                 v.options.screenshot.c_str());
+    return 1;
+  }
+  return v.exit_status;
 }
 
 const Viewer::FrameReport& Viewer::last_frame() const { return impl_->report; }
