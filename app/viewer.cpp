@@ -529,7 +529,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
 
   if (v.fonts_dirty) v.rebuild_fonts();
   if (v.texture_stale) {
-    v.display->upload(v.image.data(), v.image_info.width, v.image_info.height);
+    v.display->upload(v.image.data(), v.image_info.data_width, v.image_info.data_height);
     v.texture_stale = false;
   }
 
@@ -569,7 +569,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   glClear(GL_COLOR_BUFFER_BIT);
   glDisable(GL_SCISSOR_TEST);
   const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
-  v.display->draw(ui::fit_image(area, v.display->width(), v.display->height()), v.settings.exposure_ev,
+  v.display->draw(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
                   v.settings.srgb);
   glViewport(0, 0, fb_w, fb_h);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

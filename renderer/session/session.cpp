@@ -132,20 +132,9 @@ void RenderSession::finish_pass_locked() {
     done_cv_.notify_all();
     return;
   }
-  const Camera& cam = settings_.scene->camera;
   const double pass_ms = std::chrono::duration<double, std::milli>(now - pass_started_).count();
   if (pass_.preview) {
-    // Blow the preview up to full size so the viewer needs no special case.
-    const int s = pass_.preview_scale;
-    std::vector<float> rgb(3 * film_.pixel_count());
-    for (int y = 0; y < cam.height; ++y)
-      for (int x = 0; x < cam.width; ++x) {
-        const float* src = &preview_[3 * (static_cast<std::size_t>(y / s) * pass_.width + x / s)];
-        float* dst = &rgb[3 * (static_cast<std::size_t>(y) * cam.width + x)];
-        dst[0] = src[0];
-        dst[1] = src[1];
-        dst[2] = src[2];
-      }
+    std::vector<float> rgb = preview_;
     publish_locked(rgb, pass_);
     if (paused_) {
       seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
@@ -187,6 +176,9 @@ void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
   info.spp = pass.preview ? 0 : spp_done_;
   info.seconds = elapsed_locked();
   info.preview = pass.preview;
+  info.preview_scale = pass.preview ? pass.preview_scale : 1;
+  info.data_width = pass.preview ? pass.width : info.width;
+  info.data_height = pass.preview ? pass.height : info.height;
   // The UI thread only ever takes image_mutex_, never mutex_.
   {
     std::lock_guard ik(image_mutex_);
@@ -333,10 +325,24 @@ bool RenderSession::wait_until_done(std::chrono::milliseconds timeout) {
 bool RenderSession::copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const {
   std::lock_guard ik(image_mutex_);
   if (image_version_ == version || image_.empty()) return false;
-  out = image_;
   width = image_width_;
   height = image_height_;
   version = image_version_;
+  const ImageInfo& info = image_info_;
+  if (!info.preview) {
+    out = image_;
+    return true;
+  }
+  const int s = info.preview_scale;
+  out.resize(3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const float* src = &image_[3 * (static_cast<std::size_t>(y / s) * info.data_width + x / s)];
+      float* dst = &out[3 * (static_cast<std::size_t>(y) * width + x)];
+      dst[0] = src[0];
+      dst[1] = src[1];
+      dst[2] = src[2];
+    }
   return true;
 }
 

@@ -42,7 +42,12 @@ struct SessionStats {
 
 // What copy_image published: a complete pass, or a preview after a change.
 struct ImageInfo {
-  int width = 0, height = 0;
+  int width = 0, height = 0;     // of the image
+  // Of the buffer: a preview is published at its own low resolution, one value
+  // per preview_scale x preview_scale block (right and bottom blocks may be cut),
+  // so publishing and uploading it costs next to nothing.
+  int data_width = 0, data_height = 0;
+  int preview_scale = 1;
   std::uint64_t generation = 0;  // the settings generation the image shows
   std::uint32_t spp = 0;         // samples per pixel in the image (0 for a preview)
   double seconds = 0.0;          // rendering time of the generation when published
@@ -91,7 +96,9 @@ class RenderSession {
 
   // The latest completed pass as mean float RGB. Returns false (and leaves `out`
   // alone) when nothing newer than `version` exists; never waits for a pass.
+  // (This form always delivers width x height values: a preview is enlarged.)
   bool copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const;
+  // The buffer as published: info.data_width x info.data_height values.
   bool copy_image(std::vector<float>& out, ImageInfo& info, std::uint64_t& version) const;
   // The full accumulation (sum, sum of squares, count). Only while paused or
   // done (waits for the pass in flight to end); throws std::logic_error otherwise.

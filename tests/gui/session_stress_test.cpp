@@ -96,7 +96,7 @@ TEST(SessionStress, ThousandChangesWhileRendering) {
     }
     if (session.copy_image(rgb, info, version)) {
       ++images;
-      ASSERT_EQ(rgb.size(), 3u * static_cast<std::size_t>(info.width) * static_cast<std::size_t>(info.height));
+      ASSERT_EQ(rgb.size(), 3u * static_cast<std::size_t>(info.data_width) * static_cast<std::size_t>(info.data_height));
     }
     const SessionStats st = session.stats();
     ASSERT_LE(st.progress, 1.0);
