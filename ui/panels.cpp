@@ -44,7 +44,8 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
   if (ImGui::BeginCombo("Strategy", current.c_str())) {
     for (int i = 0; i < kTechniqueCount; ++i) {
       const auto t = static_cast<Technique>(i);
-      const std::string name(technique_name(t));
+      std::string name(technique_name(t));
+      if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
       if (ImGui::Selectable(name.c_str(), !s.mixture && s.single == t)) {
         s.mixture = false;
         s.single = t;
