@@ -1,13 +1,21 @@
 #include "renderer/session/session.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 namespace pdflab {
 
 using Clock = std::chrono::steady_clock;
 
-RenderSession::RenderSession(int threads) {
+RenderSession::RenderSession(int threads) { start_workers(threads); }
+
+RenderSession::RenderSession(const SessionOptions& options) : options_(options) { start_workers(options.threads); }
+
+void RenderSession::start_workers(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   workers_.reserve(static_cast<std::size_t>(threads));
   for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { worker_main(); });
@@ -63,7 +71,19 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   seconds_before_ = 0.0;
   running_clock_ = false;
   next_pass_spp_ = 1;
+  preview_due_ = options_.preview;
   pass_.generation = generation_.load();
+}
+
+int RenderSession::preview_scale_locked() const {
+  const Camera& cam = settings_.scene->camera;
+  const double pixels = static_cast<double>(cam.width) * cam.height;
+  // Nothing measured yet: guess a modest half a million samples a second per
+  // worker (deep paths in the book's scene); the first full pass corrects it.
+  const double rate = full_samples_per_second_ > 0.0 ? full_samples_per_second_ : 5e5 * static_cast<double>(workers_.size());
+  const double budget_samples = rate * options_.preview_budget_ms * 1e-3;
+  const double scale = std::ceil(std::sqrt(pixels / std::max(1.0, budget_samples)));
+  return static_cast<int>(std::clamp(scale, 1.0, 16.0));
 }
 
 void RenderSession::start_pass_locked() {
@@ -75,10 +95,22 @@ void RenderSession::start_pass_locked() {
   const Camera& cam = settings_.scene->camera;
   pass_.id += 1;
   pass_.generation = generation_.load();
-  pass_.first_sample = spp_done_;
-  pass_.spp = spp;
-  pass_.tiles_x = (cam.width + kTile - 1) / kTile;
-  pass_.tiles = pass_.tiles_x * ((cam.height + kTile - 1) / kTile);
+  const int scale = preview_due_ ? preview_scale_locked() : 1;
+  preview_due_ = false;
+  pass_.preview = scale > 1;
+  pass_.preview_scale = scale;
+  pass_.width = (cam.width + scale - 1) / scale;
+  pass_.height = (cam.height + scale - 1) / scale;
+  if (pass_.preview) {
+    pass_.first_sample = 0;
+    pass_.spp = 1;
+    preview_.assign(3 * static_cast<std::size_t>(pass_.width) * static_cast<std::size_t>(pass_.height), 0.0f);
+  } else {
+    pass_.first_sample = spp_done_;
+    pass_.spp = spp;
+  }
+  pass_.tiles_x = (pass_.width + kTile - 1) / kTile;
+  pass_.tiles = pass_.tiles_x * ((pass_.height + kTile - 1) / kTile);
   next_tile_.store(0);
   tiles_finished_.store(0);
   pass_open_ = true;
@@ -100,23 +132,29 @@ void RenderSession::finish_pass_locked() {
     done_cv_.notify_all();
     return;
   }
-  const Camera& cam = settings_.scene->camera;
+  const double pass_ms = std::chrono::duration<double, std::milli>(now - pass_started_).count();
+  if (pass_.preview) {
+    std::vector<float> rgb = preview_;
+    publish_locked(rgb, pass_);
+    if (paused_) {
+      seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
+      running_clock_ = false;
+    } else {
+      start_pass_locked();
+    }
+    done_cv_.notify_all();
+    return;
+  }
   spp_done_ += pass_.spp;
-  samples_done_ += static_cast<std::uint64_t>(pass_.spp) * film_.pixel_count();
+  const std::uint64_t pass_samples = static_cast<std::uint64_t>(pass_.spp) * film_.pixel_count();
+  samples_done_ += pass_samples;
+  if (pass_ms > 1.0) full_samples_per_second_ = static_cast<double>(pass_samples) / (pass_ms * 1e-3);
 
-  // Publish the image for the viewer: the UI thread only ever takes image_mutex_.
   std::vector<float> rgb;
   film_.mean_rgb(rgb);
-  {
-    std::lock_guard ik(image_mutex_);
-    image_.swap(rgb);
-    image_width_ = cam.width;
-    image_height_ = cam.height;
-    ++image_version_;
-  }
+  publish_locked(rgb, pass_);
 
   // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
-  const double pass_ms = std::chrono::duration<double, std::milli>(now - pass_started_).count();
   if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;
   if (pass_ms > 120.0 && next_pass_spp_ > 1) next_pass_spp_ /= 2;
 
@@ -130,7 +168,35 @@ void RenderSession::finish_pass_locked() {
   done_cv_.notify_all();
 }
 
+void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
+  ImageInfo info;
+  info.width = settings_.scene->camera.width;
+  info.height = settings_.scene->camera.height;
+  info.generation = pass.generation;
+  info.spp = pass.preview ? 0 : spp_done_;
+  info.seconds = elapsed_locked();
+  info.preview = pass.preview;
+  info.preview_scale = pass.preview ? pass.preview_scale : 1;
+  info.data_width = pass.preview ? pass.width : info.width;
+  info.data_height = pass.preview ? pass.height : info.height;
+  // The UI thread only ever takes image_mutex_, never mutex_.
+  {
+    std::lock_guard ik(image_mutex_);
+    image_.swap(rgb);
+    image_width_ = info.width;
+    image_height_ = info.height;
+    image_info_ = info;
+    ++image_version_;
+  }
+  if (options_.on_image) options_.on_image();
+}
+
 void RenderSession::worker_main() {
+  if (options_.background_priority) {
+    // Per-thread on Linux; raising one's own nice value needs no privilege.
+    // Failure only costs UI smoothness, so it is ignored.
+    (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+  }
   std::uint64_t seen_pass = 0;
   std::unique_lock lk(mutex_);
   for (;;) {
@@ -146,12 +212,14 @@ void RenderSession::worker_main() {
       const int tile = next_tile_.fetch_add(1, std::memory_order_relaxed);
       if (tile >= pass.tiles) break;
       if (generation_.load(std::memory_order_relaxed) != pass.generation) break;
-      render_tile(pass, tile, local);
+      if (pass.preview) render_preview_tile(pass, tile, local);
+      else render_tile(pass, tile, local);
       tiles_finished_.fetch_add(1, std::memory_order_relaxed);
     }
 
     lk.lock();
-    if (pass.generation == generation_.load()) drops_ += local;
+    // Preview samples are not part of the estimate, so their drops are not counted either.
+    if (pass.generation == generation_.load() && !pass.preview) drops_ += local;
     if (--inside_ == 0 && pass_open_ && pass_.id == pass.id) finish_pass_locked();
   }
 }
@@ -171,6 +239,37 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
         film_.add(pixel, render_pixel_sample(scene, plan_, seed, x, y, s, drops));
     }
   }
+}
+
+void RenderSession::render_preview_tile(const Pass& pass, int tile, DropCounts& drops) {
+  const Scene& scene = *settings_.scene;
+  const int s = pass.preview_scale;
+  const int x0 = (tile % pass.tiles_x) * kTile;
+  const int y0 = (tile / pass.tiles_x) * kTile;
+  const int x1 = std::min(x0 + kTile, pass.width);
+  const int y1 = std::min(y0 + kTile, pass.height);
+  for (int py = y0; py < y1; ++py) {
+    for (int px = x0; px < x1; ++px) {
+      // The block's centre pixel, so the preview is not shifted against the image.
+      const int x = std::min(px * s + s / 2, scene.camera.width - 1);
+      const int y = std::min(py * s + s / 2, scene.camera.height - 1);
+      const Vec3 c = render_pixel_sample(scene, plan_, settings_.seed, x, y, 0, drops);
+      float* dst = &preview_[3 * (static_cast<std::size_t>(py) * pass.width + px)];
+      dst[0] = c.x;
+      dst[1] = c.y;
+      dst[2] = c.z;
+    }
+  }
+}
+
+void RenderSession::set_target_spp(std::uint32_t target_spp) {
+  {
+    std::lock_guard lk(mutex_);
+    if (pending_) pending_settings_.target_spp = target_spp;
+    settings_.target_spp = target_spp;
+    if (!paused_ && !pass_open_ && !pending_) start_pass_locked();
+  }
+  done_cv_.notify_all();
 }
 
 void RenderSession::set_paused(bool paused) {
@@ -197,7 +296,7 @@ SessionStats RenderSession::stats() const {
   st.seconds = elapsed_locked();
   std::uint64_t partial = 0;
   double pass_fraction = 0.0;
-  if (pass_open_ && pass_.tiles > 0 && pass_.generation == generation_.load()) {
+  if (pass_open_ && !pass_.preview && pass_.tiles > 0 && pass_.generation == generation_.load()) {
     pass_fraction = static_cast<double>(tiles_finished_.load()) / pass_.tiles;
     partial = static_cast<std::uint64_t>(pass_fraction * pass_.spp * static_cast<double>(film_.pixel_count()));
   }
@@ -226,9 +325,32 @@ bool RenderSession::wait_until_done(std::chrono::milliseconds timeout) {
 bool RenderSession::copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const {
   std::lock_guard ik(image_mutex_);
   if (image_version_ == version || image_.empty()) return false;
-  out = image_;
   width = image_width_;
   height = image_height_;
+  version = image_version_;
+  const ImageInfo& info = image_info_;
+  if (!info.preview) {
+    out = image_;
+    return true;
+  }
+  const int s = info.preview_scale;
+  out.resize(3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const float* src = &image_[3 * (static_cast<std::size_t>(y / s) * info.data_width + x / s)];
+      float* dst = &out[3 * (static_cast<std::size_t>(y) * width + x)];
+      dst[0] = src[0];
+      dst[1] = src[1];
+      dst[2] = src[2];
+    }
+  return true;
+}
+
+bool RenderSession::copy_image(std::vector<float>& out, ImageInfo& info, std::uint64_t& version) const {
+  std::lock_guard ik(image_mutex_);
+  if (image_version_ == version || image_.empty()) return false;
+  out = image_;
+  info = image_info_;
   version = image_version_;
   return true;
 }

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -39,10 +40,39 @@ struct SessionStats {
   bool paused = false;
 };
 
+// What copy_image published: a complete pass, or a preview after a change.
+struct ImageInfo {
+  int width = 0, height = 0;     // of the image
+  // Of the buffer: a preview is published at its own low resolution, one value
+  // per preview_scale x preview_scale block (right and bottom blocks may be cut),
+  // so publishing and uploading it costs next to nothing.
+  int data_width = 0, data_height = 0;
+  int preview_scale = 1;
+  std::uint64_t generation = 0;  // the settings generation the image shows
+  std::uint32_t spp = 0;         // samples per pixel in the image (0 for a preview)
+  double seconds = 0.0;          // rendering time of the generation when published
+  bool preview = false;          // low-resolution first look, not part of the film
+};
+
+struct SessionOptions {
+  int threads = 0;  // <= 0: one per hardware thread
+  // Workers run at a lower scheduling priority so an interactive thread in the
+  // same process keeps its frame rate while every core renders.
+  bool background_priority = false;
+  // After each change, render one cheap reduced-resolution pass first (never
+  // summed into the film) so the first image of new settings appears quickly.
+  bool preview = false;
+  double preview_budget_ms = 10.0;  // aimed duration of the preview pass
+  // Called by a worker right after each new image is published (a viewer wakes
+  // its event loop with it). Must be cheap and safe to call from any thread.
+  std::function<void()> on_image;
+};
+
 class RenderSession {
  public:
   // threads <= 0: one per hardware thread.
   explicit RenderSession(int threads = 0);
+  explicit RenderSession(const SessionOptions& options);
   ~RenderSession();
   RenderSession(const RenderSession&) = delete;
   RenderSession& operator=(const RenderSession&) = delete;
@@ -52,6 +82,11 @@ class RenderSession {
   void set_settings(RenderSettings settings);
   RenderSettings settings() const;
   void set_paused(bool paused);
+  // Changes when rendering stops (0: never) without restarting the accumulation;
+  // a target below the current spp stops after the pass in flight.
+  void set_target_spp(std::uint32_t target_spp);
+  // Bumped by every set_settings; compare with ImageInfo::generation.
+  std::uint64_t generation() const { return generation_.load(); }
 
   SessionStats stats() const;
   int thread_count() const { return static_cast<int>(workers_.size()); }
@@ -61,7 +96,10 @@ class RenderSession {
 
   // The latest completed pass as mean float RGB. Returns false (and leaves `out`
   // alone) when nothing newer than `version` exists; never waits for a pass.
+  // (This form always delivers width x height values: a preview is enlarged.)
   bool copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const;
+  // The buffer as published: info.data_width x info.data_height values.
+  bool copy_image(std::vector<float>& out, ImageInfo& info, std::uint64_t& version) const;
   // The full accumulation (sum, sum of squares, count). Only while paused or
   // done (waits for the pass in flight to end); throws std::logic_error otherwise.
   Film copy_film() const;
@@ -73,10 +111,17 @@ class RenderSession {
     std::uint32_t first_sample = 0;
     std::uint32_t spp = 0;
     int tiles_x = 0, tiles = 0;
+    bool preview = false;
+    int preview_scale = 1;  // preview pixel = preview_scale x preview_scale image pixels
+    int width = 0, height = 0;  // of the grid the tiles cover
   };
 
+  void start_workers(int threads);
   void worker_main();
   void render_tile(const Pass& pass, int tile, DropCounts& drops);
+  void render_preview_tile(const Pass& pass, int tile, DropCounts& drops);
+  void publish_locked(std::vector<float>& rgb, const Pass& pass);
+  int preview_scale_locked() const;
   void finish_pass_locked();
   void apply_settings_locked(RenderSettings settings, const SamplingPlan& plan);
   void start_pass_locked();
@@ -106,6 +151,10 @@ class RenderSession {
   bool running_clock_ = false;
   std::uint32_t next_pass_spp_ = 1;
   std::chrono::steady_clock::time_point pass_started_;
+  SessionOptions options_;
+  bool preview_due_ = false;          // the next pass of this generation is a preview
+  double full_samples_per_second_ = 0.0;  // measured on full passes, sizes the preview
+  std::vector<float> preview_;        // preview pixels, written by workers (disjoint)
 
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<int> next_tile_{0};
@@ -117,6 +166,7 @@ class RenderSession {
   std::vector<float> image_;
   int image_width_ = 0, image_height_ = 0;
   std::uint64_t image_version_ = 0;
+  ImageInfo image_info_;
 };
 
 }  // namespace pdflab

@@ -1,0 +1,622 @@
+#include "app/viewer.h"
+
+#include "app/assets.h"
+#include "renderer/error.h"
+#include "renderer/film/image_io.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+#include "ui/display.h"
+#include "ui/panels.h"
+#include "ui/screenshot.h"
+
+// glad before GLFW: glad provides the GL declarations, GLFW must not.
+#include <glad/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <future>
+#include <optional>
+#include <stdexcept>
+
+#include <time.h>
+
+#ifndef PDFLAB_VERSION
+#define PDFLAB_VERSION "unknown"
+#endif
+
+namespace pdflab {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr float kPanelWidth = 400.0f;        // at content scale 1
+constexpr double kFramePeriod = 1.0 / 60.0;  // while something changes on screen
+constexpr double kIdlePeriod = 0.25;         // paused or done: wake on input or now and then
+constexpr const char* kUiFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+std::vector<std::string> list_scene_files() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  const fs::path dir = fs::path(asset_dir()) / "scenes";
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file(ec) && entry.path().extension() == ".json") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+bool all_zero(const Strategy& s) {
+  return std::all_of(s.weights.begin(), s.weights.end(), [](float w) { return !(w > 0.0f); });
+}
+
+void glfw_error(int code, const char* message) { std::fprintf(stderr, "pdflab: GLFW error %d: %s\n", code, message); }
+
+// The screenshot folder: $PDFLAB_SCREENSHOT_DIR, else ./screenshots.
+std::string default_screenshot_dir() {
+  if (const char* env = std::getenv("PDFLAB_SCREENSHOT_DIR"); env && *env) return env;
+  return "screenshots";
+}
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+}  // namespace
+
+struct Viewer::Impl {
+  ViewerOptions options;
+  GLFWwindow* window = nullptr;
+  bool imgui_ready = false;
+  std::unique_ptr<ui::ImageDisplay> display;
+  std::unique_ptr<RenderSession> session;
+
+  std::shared_ptr<const Scene> base_scene;  // as loaded
+  std::string scene_path;
+  std::shared_ptr<const Scene> render_scene;  // with depth and resolution applied
+  int render_scene_depth = -1;
+  float render_scene_scale = -1.0f;
+
+  ui::ViewerSettings settings;
+  ui::ViewerSettings applied;  // what the session renders now
+  ui::PanelState panel;
+  ui::UiStatus status;
+
+  std::vector<float> image;
+  ImageInfo image_info;
+  std::uint64_t image_version = 0;
+  bool texture_stale = false;
+
+  std::vector<int> keys;  // pressed since the last frame, from the GLFW callback
+  // Redrawing costs CPU time the render threads could use (and llvmpipe draws
+  // on the CPU), so a frame is drawn only when something on it can change.
+  std::uint64_t input_events = 0, seen_input_events = 0;
+  int settle_frames = 2;  // ImGui needs a frame or two after input to settle hover and layout
+  Clock::time_point last_draw{};
+
+  bool screenshot_wanted = false;
+  std::future<ui::SavedScreenshot> save_job;
+  ui::ScreenshotData saving;  // kept until the job reports, for a retry after failure
+  std::optional<ui::ScreenshotData> failed_save;
+
+  bool fonts_dirty = true;
+  float content_scale = 1.0f;
+  float framebuffer_scale = 1.0f;
+
+  FrameReport report;
+  int exit_status = 0;
+  bool cli_done = false;
+  Clock::time_point started = Clock::now();
+
+  double now() const { return std::chrono::duration<double>(Clock::now() - started).count(); }
+  bool cli_mode() const { return !options.screenshot.empty(); }
+
+  void open(const ViewerOptions& o);
+  void close();
+  void open_window(int image_width, int image_height);
+  void rebuild_fonts();
+  void on_key(int key);
+  bool apply_render_settings();
+  void load_scene(const std::string& path);
+  void pull_image();
+  void service_screenshots();
+  void start_save(ui::ScreenshotData data);
+  ui::ScreenshotData capture() const;
+  void notice(std::string text, bool error) {
+    status.notice = {std::move(text), error, now()};
+    settle_frames = 2;
+  }
+  void fill_status();
+};
+
+void Viewer::Impl::open(const ViewerOptions& o) {
+  options = o;
+  // Everything the user typed is checked before a window appears.
+  Scene scene = load_scene_file(o.scene);
+  const Strategy strategy = Strategy::parse(o.strategy);
+  (void)SamplingPlan::make(strategy, scene);
+  if (cli_mode()) {
+    if (image_format_for(o.screenshot) != ImageFormat::Png)
+      throw InputError("--screenshot '" + o.screenshot + "' must name a .png file (the .pfm and .json go beside it)");
+    check_output_path(o.screenshot);
+    if (options.spp == 0) options.spp = 64;
+  }
+
+  settings.sampling = ui::SamplingSettings::from(strategy);
+  settings.max_depth = scene.max_depth;
+  settings.stop_spp = cli_mode() ? options.spp : o.spp;
+  settings.screenshot_dir = default_screenshot_dir();
+  scene_path = o.scene;
+  base_scene = std::make_shared<const Scene>(std::move(scene));
+  status.scene_files = list_scene_files();
+
+  open_window(base_scene->camera.width, base_scene->camera.height);
+
+  SessionOptions so;
+  so.background_priority = true;
+  so.preview = true;
+  // A new image ends the wait between frames at once instead of at the next tick.
+  so.on_image = [] { glfwPostEmptyEvent(); };
+  session = std::make_unique<RenderSession>(so);
+  if (!apply_render_settings()) throw InputError(status.settings_error);
+}
+
+void Viewer::Impl::open_window(int image_width, int image_height) {
+  glfwSetErrorCallback(glfw_error);
+  // Under Mesa's software rasteriser (llvmpipe: Xvfb, VMs, remote desktops) its
+  // own rasteriser threads would fight the render workers for every core and
+  // hand each frame across threads; drawing on the UI thread halves the frame
+  // time there (bench_viewer). Ignored by hardware drivers; a user's value wins.
+  ::setenv("LP_NUM_THREADS", "0", 0);
+  if (!glfwInit()) throw std::runtime_error("cannot open a window (no display? try xvfb-run, or `pdflab render`)");
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+
+  float xs = 1.0f, ys = 1.0f;
+  GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+  if (monitor) glfwGetMonitorContentScale(monitor, &xs, &ys);
+  const float scale = std::clamp(std::max(xs, ys), 0.5f, 4.0f);
+  int width = options.window_width, height = options.window_height;
+  if (width <= 0 || height <= 0) {
+    // The image at one image pixel per screen pixel (per `scale` on HiDPI
+    // screens, like everything else), within reason, plus the panel.
+    const int image_w = static_cast<int>(static_cast<float>(std::clamp(image_width, 320, 1000)) * scale);
+    const int image_h = static_cast<int>(static_cast<float>(std::clamp(image_height, 320, 1000)) * scale);
+    width = image_w + static_cast<int>(kPanelWidth * scale);
+    height = std::max(image_h, static_cast<int>(800.0f * scale));
+    if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
+      width = std::min(width, mode->width * 19 / 20);
+      height = std::min(height, mode->height * 19 / 20);
+    }
+  }
+  const std::string title = "pdflab - " + base_scene->name;
+  window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!window) throw std::runtime_error("cannot create an OpenGL 3.3 core window");
+  glfwMakeContextCurrent(window);
+  if (gladLoadGL(glfwGetProcAddress) == 0) throw std::runtime_error("cannot load OpenGL 3.3 functions");
+  // Pacing is ours (see frame()): a blocking swap would hide the frame's real cost.
+  glfwSwapInterval(0);
+
+  glfwSetWindowUserPointer(window, this);
+  // Installed before ImGui's, which then chains to them.
+  static constexpr auto self = [](GLFWwindow* w) { return static_cast<Impl*>(glfwGetWindowUserPointer(w)); };
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+    ++self(w)->input_events;
+    if (action == GLFW_PRESS) self(w)->keys.push_back(key);
+  });
+  glfwSetCharCallback(window, [](GLFWwindow* w, unsigned int) { ++self(w)->input_events; });
+  glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int, int, int) { ++self(w)->input_events; });
+  glfwSetScrollCallback(window, [](GLFWwindow* w, double, double) { ++self(w)->input_events; });
+  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double, double) { ++self(w)->input_events; });
+  glfwSetWindowRefreshCallback(window, [](GLFWwindow* w) { ++self(w)->input_events; });
+  glfwSetWindowFocusCallback(window, [](GLFWwindow* w, int) { ++self(w)->input_events; });
+  glfwSetWindowContentScaleCallback(
+      window, [](GLFWwindow* w, float, float) { static_cast<Impl*>(glfwGetWindowUserPointer(w))->fonts_dirty = true; });
+  glfwSetFramebufferSizeCallback(window, [](GLFWwindow* w, int, int) {
+    self(w)->fonts_dirty = true;
+    ++self(w)->input_events;
+  });
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+  imgui_ready = true;
+
+  display = std::make_unique<ui::ImageDisplay>();
+  std::string error;
+  if (!display->init(error)) throw std::runtime_error("display shaders: " + error);
+}
+
+void Viewer::Impl::rebuild_fonts() {
+  fonts_dirty = false;
+  float xs = 1.0f, ys = 1.0f;
+  glfwGetWindowContentScale(window, &xs, &ys);
+  int ww = 0, wh = 0, fw = 0, fh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  glfwGetFramebufferSize(window, &fw, &fh);
+  const float new_content = std::clamp(std::max(xs, ys), 0.5f, 4.0f);
+  // Where window coordinates are points (macOS, Wayland), the framebuffer is
+  // larger than the window; ImGui works in window coordinates.
+  const float new_fb = ww > 0 && fw > 0 ? static_cast<float>(fw) / static_cast<float>(ww) : framebuffer_scale;
+  ImGuiIO& io = ImGui::GetIO();
+  if (new_content == content_scale && new_fb == framebuffer_scale && io.Fonts->Fonts.Size > 0) return;
+  content_scale = new_content;
+  framebuffer_scale = new_fb;
+
+  io.Fonts->Clear();
+  const float pixels = 15.0f * content_scale;  // rasterised at the real pixel size, so text stays sharp
+  std::error_code ec;
+  if (fs::exists(kUiFont, ec)) {
+    io.Fonts->AddFontFromFileTTF(kUiFont, pixels);
+  } else {
+    ImFontConfig cfg;
+    cfg.SizePixels = 13.0f * content_scale;
+    io.Fonts->AddFontDefault(&cfg);
+  }
+  io.FontGlobalScale = 1.0f / framebuffer_scale;
+  ImGui_ImplOpenGL3_DestroyFontsTexture();
+  ImGui_ImplOpenGL3_CreateFontsTexture();
+
+  ImGuiStyle& style = ImGui::GetStyle();
+  style = ImGuiStyle();
+  ImGui::StyleColorsDark(&style);
+  style.WindowRounding = 0.0f;
+  style.FrameRounding = 3.0f;
+  style.GrabRounding = 3.0f;
+  style.WindowBorderSize = 0.0f;
+  style.ScaleAllSizes(content_scale / framebuffer_scale);
+}
+
+void Viewer::Impl::close() {
+  session.reset();  // workers stop first: nothing renders into a closing viewer
+  if (save_job.valid()) save_job.wait();
+  display.reset();
+  if (imgui_ready) {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    imgui_ready = false;
+  }
+  if (window) glfwDestroyWindow(window);
+  window = nullptr;
+  glfwTerminate();
+}
+
+bool Viewer::Impl::apply_render_settings() {
+  const Strategy strategy = settings.sampling.strategy();
+  if (all_zero(strategy)) {
+    status.settings_error = "Every mixture weight is 0; still showing the last valid strategy.";
+    return false;
+  }
+  if (!render_scene || render_scene_depth != settings.max_depth || render_scene_scale != settings.resolution_scale ||
+      render_scene.get() == base_scene.get()) {
+    auto scene = std::make_shared<Scene>(*base_scene);
+    scene->max_depth = settings.max_depth;
+    Camera& cam = scene->camera;
+    const auto scaled = [&](int size) {
+      return std::clamp(static_cast<int>(std::lround(static_cast<double>(size) * settings.resolution_scale)), 1, 16384);
+    };
+    cam.width = scaled(base_scene->camera.width);
+    cam.height = scaled(base_scene->camera.height);
+    cam.prepare();
+    render_scene = std::move(scene);
+    render_scene_depth = settings.max_depth;
+    render_scene_scale = settings.resolution_scale;
+  }
+  RenderSettings rs;
+  rs.scene = render_scene;
+  rs.strategy = strategy;
+  rs.seed = settings.seed;
+  rs.target_spp = settings.stop_spp;
+  try {
+    session->set_settings(rs);
+  } catch (const InputError& e) {
+    status.settings_error = e.what();
+    return false;
+  }
+  status.settings_error.clear();
+  applied = settings;
+  return true;
+}
+
+void Viewer::Impl::load_scene(const std::string& path) {
+  Scene loaded;
+  try {
+    loaded = load_scene_file(path);
+  } catch (const std::exception& e) {
+    status.scene_error = e.what();  // the current scene stays
+    return;
+  }
+  auto previous_scene = base_scene;
+  auto previous_render = render_scene;
+  const int previous_depth = settings.max_depth;
+  const std::string previous_path = scene_path;
+  base_scene = std::make_shared<const Scene>(std::move(loaded));
+  render_scene.reset();
+  settings.max_depth = base_scene->max_depth;
+  scene_path = path;
+  if (!apply_render_settings()) {
+    status.scene_error = "Not loaded: " + status.settings_error;
+    status.settings_error.clear();
+    base_scene = previous_scene;
+    render_scene = previous_render;
+    settings.max_depth = previous_depth;
+    scene_path = previous_path;
+    return;
+  }
+  status.scene_error.clear();
+  glfwSetWindowTitle(window, ("pdflab - " + base_scene->name).c_str());
+  status.scene_files = list_scene_files();
+}
+
+void Viewer::Impl::on_key(int key) {
+  // Typing a path must not pause the render or restart it.
+  if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12 && key != GLFW_KEY_ESCAPE) return;
+  switch (key) {
+    case GLFW_KEY_SPACE:
+      settings.paused = !settings.paused;
+      session->set_paused(settings.paused);
+      break;
+    case GLFW_KEY_R: apply_render_settings(); break;
+    case GLFW_KEY_F12: screenshot_wanted = true; break;
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
+    case GLFW_KEY_1:
+    case GLFW_KEY_2:
+    case GLFW_KEY_3:
+      settings.sampling = ui::preset_sampling(static_cast<ui::Preset>(key - GLFW_KEY_0));
+      apply_render_settings();
+      break;
+    case GLFW_KEY_H:
+    case GLFW_KEY_F1: panel.show_help = !panel.show_help; break;
+    default: break;
+  }
+}
+
+void Viewer::Impl::pull_image() {
+  // Never waits for a worker: copy_image only takes the image lock for a copy.
+  if (session->copy_image(image, image_info, image_version)) {
+    texture_stale = true;
+    report.new_image = true;
+  }
+}
+
+ui::ScreenshotData Viewer::Impl::capture() const {
+  ui::ScreenshotData d;
+  d.rgb = image;
+  d.width = image_info.width;
+  d.height = image_info.height;
+  d.transfer = settings.srgb ? Transfer::Srgb : Transfer::Gamma2;
+  d.exposure_ev = settings.exposure_ev;
+  d.scene_name = base_scene->name;
+  d.scene_file = scene_path;
+  d.strategy = applied.sampling.strategy();
+  d.spp = image_info.spp;
+  d.seconds = image_info.seconds;
+  d.seed = applied.seed;
+  d.max_depth = applied.max_depth;
+  d.version = PDFLAB_VERSION;
+  return d;
+}
+
+void Viewer::Impl::start_save(ui::ScreenshotData data) {
+  saving = std::move(data);
+  // Encoding a PNG takes tens of milliseconds: off the UI thread. The job reads
+  // `saving` only; the UI thread leaves it alone until the job reports.
+  save_job = std::async(std::launch::async, [this, folder = settings.screenshot_dir] {
+    return ui::save_screenshot_in(folder, saving, std::time(nullptr));
+  });
+}
+
+void Viewer::Impl::service_screenshots() {
+  const bool current = !image.empty() && image_info.generation == session->generation() && !image_info.preview;
+
+  if (cli_mode() && !cli_done && current && image_info.spp >= options.spp) {
+    cli_done = true;
+    try {
+      const ui::SavedScreenshot saved = ui::save_screenshot_as(options.screenshot, capture());
+      std::printf("%u spp, %dx%d, %.2f s -> %s (+ %s, %s)\n", image_info.spp, image_info.width, image_info.height,
+                  image_info.seconds, saved.png.c_str(), saved.pfm.c_str(), saved.json.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "pdflab: error: screenshot not saved: %s\n", e.what());
+      exit_status = 1;
+    }
+    glfwSetWindowShouldClose(window, GLFW_TRUE);
+  }
+
+  if (save_job.valid() && save_job.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    try {
+      const ui::SavedScreenshot saved = save_job.get();
+      notice("Saved " + saved.png + "\n  + " + fs::path(saved.pfm).filename().string() + ", " +
+                 fs::path(saved.json).filename().string(),
+             false);
+      failed_save.reset();
+    } catch (const std::exception& e) {
+      notice(std::string("Screenshot NOT saved: ") + e.what() +
+                 "\nThe image is kept: choose another folder and press Retry.",
+             true);
+      failed_save = std::move(saving);
+    }
+  }
+  if (save_job.valid()) return;
+
+  if (screenshot_wanted && current) {
+    screenshot_wanted = false;
+    start_save(capture());
+  }
+}
+
+void Viewer::Impl::fill_status() {
+  status.stats = session->stats();
+  status.threads = session->thread_count();
+  status.scene_name = base_scene->name;
+  status.scene_path = scene_path;
+  status.base_width = base_scene->camera.width;
+  status.base_height = base_scene->camera.height;
+  status.width = render_scene ? render_scene->camera.width : 0;
+  status.height = render_scene ? render_scene->camera.height : 0;
+  status.showing_preview = image_info.preview;
+  status.shown_spp = image_info.spp;
+  status.screenshot_pending = screenshot_wanted || save_job.valid();
+  status.can_retry_screenshot = failed_save.has_value() && !save_job.valid();
+  status.now = now();
+  status.frame_ms = report.work_ms;
+}
+
+Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
+  try {
+    impl_->open(options);
+  } catch (...) {
+    impl_->close();
+    throw;
+  }
+}
+
+Viewer::~Viewer() { impl_->close(); }
+
+bool Viewer::frame(bool paced, bool force_draw) {
+  Impl& v = *impl_;
+  if (glfwWindowShouldClose(v.window)) return false;
+  const auto t0 = Clock::now();
+  const double cpu0 = thread_cpu_ms();
+  v.report.new_image = false;
+  v.report.drawn = false;
+  glfwPollEvents();
+  for (int key : v.keys) v.on_key(key);
+  v.keys.clear();
+  v.pull_image();
+  v.service_screenshots();
+
+  int fb_w = 0, fb_h = 0;
+  glfwGetFramebufferSize(v.window, &fb_w, &fb_h);
+  if (fb_w <= 0 || fb_h <= 0 || glfwGetWindowAttrib(v.window, GLFW_ICONIFIED)) {
+    // Minimised: nothing to draw. Sleep until an event (restore) or a timeout
+    // that keeps the --screenshot mode and save notices going.
+    glfwWaitEventsTimeout(0.1);
+    return !glfwWindowShouldClose(v.window);
+  }
+
+  if (v.input_events != v.seen_input_events) {
+    v.seen_input_events = v.input_events;
+    v.settle_frames = 3;
+  }
+  // Elapsed time and samples/s tick between images: a few redraws a second show that.
+  const bool draw = force_draw || v.texture_stale || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
+                    t0 - v.last_draw > std::chrono::milliseconds(250);
+  if (!draw) {
+    if (paced) glfwWaitEventsTimeout(kFramePeriod);
+    return !glfwWindowShouldClose(v.window);
+  }
+  if (v.settle_frames > 0) --v.settle_frames;
+  v.last_draw = t0;
+
+  if (v.fonts_dirty) v.rebuild_fonts();
+  if (v.texture_stale) {
+    v.display->upload(v.image.data(), v.image_info.data_width, v.image_info.data_height);
+    v.texture_stale = false;
+  }
+
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  v.fill_status();
+  const ImGuiIO& io = ImGui::GetIO();
+  const float panel_width = std::min(kPanelWidth * v.content_scale / v.framebuffer_scale, io.DisplaySize.x);
+  ui::UiRequests requests;
+  ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
+  ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
+  ui::draw_image_badges(v.settings, v.status);
+  ImGui::Render();
+
+  if (!requests.load_scene.empty()) v.load_scene(requests.load_scene);
+  else if (requests.restart_render) v.apply_render_settings();
+  if (requests.pause_changed) v.session->set_paused(v.settings.paused);
+  if (requests.stop_changed) {
+    v.session->set_target_spp(v.settings.stop_spp);
+    v.applied.stop_spp = v.settings.stop_spp;
+  }
+  if (requests.screenshot) v.screenshot_wanted = true;
+  if (requests.retry_screenshot && v.failed_save) {
+    ui::ScreenshotData data = std::move(*v.failed_save);
+    v.failed_save.reset();
+    v.start_save(std::move(data));
+  }
+
+  glViewport(0, 0, fb_w, fb_h);
+  glClearColor(0.05f, 0.05f, 0.055f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  const int panel_px = static_cast<int>(panel_width * v.framebuffer_scale);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(fb_w - panel_px, 0, panel_px, fb_h);
+  glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glDisable(GL_SCISSOR_TEST);
+  const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
+  v.display->draw(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
+                  v.settings.srgb);
+  glViewport(0, 0, fb_w, fb_h);
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  glfwSwapBuffers(v.window);
+
+  const auto t1 = Clock::now();
+  v.report.work_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  v.report.cpu_ms = thread_cpu_ms() - cpu0;
+  v.report.drawn = true;
+  v.report.shown_generation = v.image_info.generation;
+  v.report.shown_preview = v.image_info.preview;
+  v.report.shown_spp = v.image_info.spp;
+
+  if (paced) {
+    // Events wake the wait early, so input is never delayed by the pacing.
+    const SessionStats& st = v.status.stats;
+    const bool busy = !(st.done || st.paused) || v.save_job.valid() || v.screenshot_wanted ||
+                      ImGui::IsAnyItemActive() || v.status.now - v.status.notice.shown_at < 0.5;
+    const double period = busy ? kFramePeriod : kIdlePeriod;
+    const double spent = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (spent < period) glfwWaitEventsTimeout(period - spent);
+  }
+  return !glfwWindowShouldClose(v.window);
+}
+
+int Viewer::run() {
+  while (frame()) {
+  }
+  Impl& v = *impl_;
+  if (v.cli_mode() && !v.cli_done) {
+    // Closed before the image was complete: say so, and don't report success.
+    std::fprintf(stderr, "pdflab: error: the window was closed before %u spp; %s was not written\n", v.options.spp,
+                 v.options.screenshot.c_str());
+    return 1;
+  }
+  return v.exit_status;
+}
+
+const Viewer::FrameReport& Viewer::last_frame() const { return impl_->report; }
+ui::ViewerSettings& Viewer::settings() { return impl_->settings; }
+void Viewer::request_restart() { impl_->apply_render_settings(); }
+std::uint64_t Viewer::session_generation() const { return impl_->session->generation(); }
+int Viewer::exit_status() const { return impl_->exit_status; }
+
+int run_viewer(const ViewerOptions& options) {
+  Viewer viewer(options);
+  return viewer.run();
+}
+
+}  // namespace pdflab

@@ -1,0 +1,61 @@
+#pragma once
+// The interactive viewer: a GLFW window showing the render session's
+// accumulation, with the ImGui panels of ui/.
+#include "ui/settings.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace pdflab {
+
+struct ViewerOptions {
+  std::string scene;
+  std::string strategy = "mix:cosine=0.5,light=0.5";
+  std::uint32_t spp = 0;   // with `screenshot`: render this many samples per pixel, save, exit
+  std::string screenshot;  // PNG path; the PFM and JSON go beside it
+  // Window size in screen coordinates (0: fit the image and the panel).
+  int window_width = 0, window_height = 0;
+};
+
+// Runs the viewer until the window closes. Returns the process exit status;
+// throws InputError for bad options (checked before any window opens).
+int run_viewer(const ViewerOptions& options);
+
+// One frame at a time, for benchmarks and tests that drive the viewer directly.
+class Viewer {
+ public:
+  explicit Viewer(const ViewerOptions& options);  // throws InputError, or std::runtime_error without a display
+  ~Viewer();
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+
+  // Handles input, shows the newest image, draws the UI. False once the window
+  // should close. Sleeps to pace itself unless `paced` is false. Draws only when
+  // something visible changed unless `force_draw` (benchmarks: a user dragging a slider).
+  bool frame(bool paced = true, bool force_draw = false);
+  int run();
+
+  struct FrameReport {
+    double work_ms = 0.0;               // from the frame's start to the swap returning
+    double cpu_ms = 0.0;                // the UI thread's CPU time in that span (not llvmpipe's threads)
+    std::uint64_t shown_generation = 0; // settings generation of the image on screen
+    bool shown_preview = false;
+    std::uint32_t shown_spp = 0;
+    bool new_image = false;             // a new image arrived this frame
+    bool drawn = false;                 // false: nothing changed, nothing was drawn
+  };
+  const FrameReport& last_frame() const;
+
+  // What a panel edit does: change the settings, then ask for them to apply.
+  ui::ViewerSettings& settings();
+  void request_restart();
+  std::uint64_t session_generation() const;
+  int exit_status() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pdflab

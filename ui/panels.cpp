@@ -1,0 +1,317 @@
+#include "ui/panels.h"
+
+#include "renderer/integrator/integrator.h"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace pdflab::ui {
+
+namespace {
+
+const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
+const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
+const ImVec4 kAmber{1.0f, 0.78f, 0.3f, 1.0f};
+const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (s < 1.0) std::snprintf(buf, sizeof buf, "%.0f ms", s * 1e3);
+  else if (s < 120.0) std::snprintf(buf, sizeof buf, "%.2f s", s);
+  else std::snprintf(buf, sizeof buf, "%dm %02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return buf;
+}
+
+// One label/value pair in a four-column statistics table.
+void stat_cell(const char* label, const char* fmt, auto... args) {
+  ImGui::TableNextColumn();
+  ImGui::TextColored(kDim, "%s", label);
+  ImGui::TableNextColumn();
+  ImGui::Text(fmt, args...);
+}
+
+void sampling_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
+  SamplingSettings& s = settings.sampling;
+  const SamplingSettings before = s;
+
+  // Combo: each technique alone, then the mixture.
+  std::string current = s.mixture ? "mixture" : std::string(technique_name(s.single));
+  if (ImGui::BeginCombo("Strategy", current.c_str())) {
+    for (int i = 0; i < kTechniqueCount; ++i) {
+      const auto t = static_cast<Technique>(i);
+      std::string name(technique_name(t));
+      if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
+      if (ImGui::Selectable(name.c_str(), !s.mixture && s.single == t)) {
+        s.mixture = false;
+        s.single = t;
+      }
+    }
+    if (ImGui::Selectable("mixture", s.mixture)) {
+      if (!s.mixture) {
+        // Start the mixture from what was shown, so the image does not jump.
+        s.weights = {};
+        s.weights[static_cast<int>(s.single)] = 1.0f;
+      }
+      s.mixture = true;
+    }
+    ImGui::EndCombo();
+  }
+
+  if (s.mixture) {
+    const auto norm = s.normalised();
+    ImGui::TextColored(kDim, "weight per technique        normalised");
+    for (int i = 0; i < kTechniqueCount; ++i) {
+      ImGui::PushID(i);
+      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+      const std::string name(technique_name(static_cast<Technique>(i)));
+      ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.2f").c_str(), ImGuiSliderFlags_AlwaysClamp);
+      ImGui::SameLine();
+      ImGui::Text("%.3f", norm[i]);
+      ImGui::PopID();
+    }
+    bool any = false;
+    for (float w : s.weights) any = any || w > 0.0f;
+    if (!any) ImGui::TextColored(kRed, "All weights are 0: the image keeps the last valid mixture.");
+  }
+
+  for (int p = 1; p <= kPresetCount; ++p) {
+    char label[48];
+    std::snprintf(label, sizeof label, "%d: %s", p, preset_label(static_cast<Preset>(p)));
+    if (p > 1) ImGui::SameLine();
+    if (ImGui::Button(label)) s = preset_sampling(static_cast<Preset>(p));
+  }
+
+  const Strategy strategy = s.strategy();
+  bool any = false;
+  for (float w : strategy.weights) any = any || w > 0.0f;
+  if (any) {
+    ImGui::TextUnformatted(strategy.to_string().c_str());
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
+    ImGui::SameLine();
+    if (strategy.is_unbiased()) {
+      ImGui::TextColored(kGreen, "unbiased");
+    } else {
+      ImGui::TextColored(kRed, "BIASED");
+      ImGui::PushStyleColor(ImGuiCol_Text, kRed);
+      ImGui::TextWrapped("Its pdf is zero away from the importance targets, so indirect light is missing.");
+      ImGui::PopStyleColor();
+    }
+  }
+  if (!status.settings_error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kRed);
+    ImGui::TextWrapped("%s", status.settings_error.c_str());
+    ImGui::PopStyleColor();
+  }
+  if (!(s == before)) requests.restart_render = true;
+}
+
+void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
+  namespace fs = std::filesystem;
+  const std::string current_name = fs::path(status.scene_path).filename().string();
+  if (ImGui::BeginCombo("Scene", current_name.c_str())) {
+    for (const std::string& file : status.scene_files) {
+      const std::string name = fs::path(file).filename().string();
+      if (ImGui::Selectable(name.c_str(), file == status.scene_path)) {
+        requests.load_scene = file;
+        state.scene_path_field = file;
+      }
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - ImGui::CalcTextSize("Load").x -
+                          ImGui::GetStyle().FramePadding.x * 2.0f - ImGui::GetStyle().ItemSpacing.x);
+  const bool entered = ImGui::InputTextWithHint("##path", "scene file path", &state.scene_path_field,
+                                                ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("Load") || entered) && !state.scene_path_field.empty()) requests.load_scene = state.scene_path_field;
+  ImGui::TextColored(kDim, "%s, %dx%d", status.scene_name.c_str(), status.width, status.height);
+  if (!status.scene_error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kRed);
+    ImGui::TextWrapped("%s", status.scene_error.c_str());
+    ImGui::PopStyleColor();
+  }
+
+  ImGui::Spacing();
+  if (ImGui::SliderInt("Max depth", &settings.max_depth, 1, 100, "%d", ImGuiSliderFlags_AlwaysClamp))
+    requests.restart_render = true;
+  const std::uint64_t step = 1;
+  if (ImGui::InputScalar("Seed", ImGuiDataType_U64, &settings.seed, &step)) requests.restart_render = true;
+
+  char current[48];
+  std::snprintf(current, sizeof current, "%.0f%%  (%dx%d)", settings.resolution_scale * 100.0, status.width,
+                status.height);
+  if (ImGui::BeginCombo("Resolution", current)) {
+    for (float scale : kResolutionScales) {
+      char label[48];
+      std::snprintf(label, sizeof label, "%.0f%%  (%dx%d)", scale * 100.0,
+                    std::max(1, static_cast<int>(static_cast<float>(status.base_width) * scale + 0.5f)),
+                    std::max(1, static_cast<int>(static_cast<float>(status.base_height) * scale + 0.5f)));
+      if (ImGui::Selectable(label, scale == settings.resolution_scale) && scale != settings.resolution_scale) {
+        settings.resolution_scale = scale;
+        requests.restart_render = true;
+      }
+    }
+    ImGui::EndCombo();
+  }
+
+  const std::uint32_t spp_step = 16;
+  if (ImGui::InputScalar("Stop at spp", ImGuiDataType_U32, &settings.stop_spp, &spp_step))
+    requests.stop_changed = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("0: never stop. Changing it does not restart.");
+
+  if (ImGui::Button(settings.paused ? "Resume (Space)" : "Pause (Space)")) {
+    settings.paused = !settings.paused;
+    requests.pause_changed = true;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Restart (R)")) requests.restart_render = true;
+}
+
+void display_section(ViewerSettings& settings) {
+  ImGui::SliderFloat("Exposure", &settings.exposure_ev, -6.0f, 6.0f, "%+.1f EV");
+  if (ImGui::IsItemClicked(ImGuiMouseButton_Right)) settings.exposure_ev = 0.0f;
+  int transfer = settings.srgb ? 1 : 0;
+  ImGui::RadioButton("gamma 2 (book)", &transfer, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("sRGB", &transfer, 1);
+  settings.srgb = transfer == 1;
+}
+
+void statistics_section(const ViewerSettings& settings, const UiStatus& status) {
+  const SessionStats& st = status.stats;
+  const std::uint64_t dropped = st.dropped.total();
+  if (ImGui::BeginTable("stats", 4, ImGuiTableFlags_SizingStretchProp)) {
+    stat_cell("spp", "%u%s", st.spp, st.done ? " done" : (st.paused ? " paused" : ""));
+    stat_cell("elapsed", "%s", format_seconds(st.seconds).c_str());
+    stat_cell("samples/s", "%.3f M", st.samples_per_second * 1e-6);
+    stat_cell("per spp", "%s", st.spp > 0 ? format_seconds(st.seconds / st.spp).c_str() : "-");
+    stat_cell("samples", "%.3f M", static_cast<double>(st.samples) * 1e-6);
+    stat_cell("threads", "%d", status.threads);
+    ImGui::TableNextColumn();
+    ImGui::TextColored(kDim, "dropped");
+    ImGui::TableNextColumn();
+    if (dropped == 0) ImGui::TextUnformatted("0");
+    else {
+      const double percent =
+          st.samples ? 100.0 * static_cast<double>(dropped) / static_cast<double>(st.samples) : 0.0;
+      if (percent < 0.001) ImGui::TextColored(kAmber, "%llu (<0.001%%)", static_cast<unsigned long long>(dropped));
+      else ImGui::TextColored(kAmber, "%llu (%.3f%%)", static_cast<unsigned long long>(dropped), percent);
+    }
+    stat_cell("UI frame", "%.1f ms", status.frame_ms);
+    ImGui::EndTable();
+  }
+  // Why samples were dropped, one reason each: the DropReason names of the renderer.
+  ImGui::TextColored(kDim, "dropped by reason:");
+  for (int r = 0; r < kDropReasonCount; ++r) {
+    const std::string name(drop_reason_name(static_cast<DropReason>(r)));
+    ImGui::TextColored(kDim, "  %s", name.c_str());
+    ImGui::SameLine();
+    ImGui::Text("%llu", static_cast<unsigned long long>(st.dropped.by_reason[r]));
+    if (r + 1 < kDropReasonCount) ImGui::SameLine();
+  }
+  if (settings.stop_spp > 0) {
+    char overlay[48];
+    std::snprintf(overlay, sizeof overlay, "%u / %u spp", st.spp, settings.stop_spp);
+    ImGui::ProgressBar(static_cast<float>(st.progress), ImVec2(-1.0f, 0.0f), overlay);
+  }
+}
+
+void screenshot_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
+  ImGui::InputText("Folder", &settings.screenshot_dir);
+  ImGui::BeginDisabled(status.screenshot_pending);
+  if (ImGui::Button(status.screenshot_pending ? "Saving..." : "Save screenshot (F12)")) requests.screenshot = true;
+  ImGui::EndDisabled();
+  if (status.can_retry_screenshot) {
+    ImGui::SameLine();
+    if (ImGui::Button("Retry save")) requests.retry_screenshot = true;
+  }
+  if (!status.notice.text.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, status.notice.error ? kRed : kGreen);
+    ImGui::TextWrapped("%s", status.notice.text.c_str());
+    ImGui::PopStyleColor();
+  }
+}
+
+}  // namespace
+
+void draw_side_panel(float width, float display_height, ViewerSettings& settings, PanelState& state,
+                     const UiStatus& status, UiRequests& requests) {
+  if (!state.scene_field_initialised) {
+    state.scene_path_field = status.scene_path;
+    state.scene_field_initialised = true;
+  }
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x - width, vp->Pos.y));
+  ImGui::SetNextWindowSize(ImVec2(width, display_height));
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoTitleBar;
+  // The viewer clears the panel's rectangle itself (kPanelBackground): a
+  // full-height filled quad is the costliest thing ImGui draws on a software
+  // rasteriser, a clear costs next to nothing.
+  ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.0f, 0.0f, 0.0f, 0.0f));
+  ImGui::Begin("pdflab", nullptr, flags);
+  ImGui::PopStyleColor();
+  ImGui::PushItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+  if (ImGui::CollapsingHeader("Sampling", ImGuiTreeNodeFlags_DefaultOpen)) sampling_section(settings, status, requests);
+  if (ImGui::CollapsingHeader("Scene and render", ImGuiTreeNodeFlags_DefaultOpen))
+    scene_section(settings, state, status, requests);
+  if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics_section(settings, status);
+  if (ImGui::CollapsingHeader("Display")) display_section(settings);
+  if (ImGui::CollapsingHeader("Screenshot", ImGuiTreeNodeFlags_DefaultOpen))
+    screenshot_section(settings, status, requests);
+  ImGui::PopItemWidth();
+  ImGui::Spacing();
+  if (ImGui::Button("Help (H)")) state.show_help = !state.show_help;
+  ImGui::End();
+}
+
+void draw_help_overlay(PanelState& state, float area_width, float area_height) {
+  if (!state.show_help) return;
+  ImGui::SetNextWindowPos(ImVec2(area_width * 0.5f, area_height * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowBgAlpha(0.9f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse;
+  if (ImGui::Begin("Keys", &state.show_help, flags)) {
+    static constexpr const char* kKeys[][2] = {
+        {"Space", "pause / resume"},
+        {"R", "restart the accumulation"},
+        {"1", "preset: cosine only"},
+        {"2", "preset: light only"},
+        {"3", "preset: book 50/50 (cosine + light)"},
+        {"F12", "screenshot: PNG + PFM + JSON"},
+        {"H, F1", "this help"},
+        {"Esc", "quit"},
+    };
+    for (const auto& k : kKeys) {
+      ImGui::TextColored(kAmber, "%s", k[0]);
+      ImGui::SameLine(ImGui::GetFontSize() * 5.0f);
+      ImGui::TextUnformatted(k[1]);
+    }
+    ImGui::Separator();
+    ImGui::TextColored(kDim, "Any change to sampling, scene or render settings\nrestarts the accumulation at once.");
+  }
+  ImGui::End();
+}
+
+void draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
+  std::string text;
+  if (status.showing_preview) text = "preview";
+  else if (settings.paused) text = "paused";
+  if (!settings.sampling.strategy().is_unbiased()) text += text.empty() ? "biased strategy" : "  |  biased strategy";
+  if (text.empty()) return;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + 8.0f, vp->Pos.y + 8.0f));
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+  if (ImGui::Begin("##badges", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text.c_str());
+  ImGui::End();
+}
+
+}  // namespace pdflab::ui

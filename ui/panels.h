@@ -1,0 +1,23 @@
+#pragma once
+// The ImGui panels. They read UiStatus, edit ViewerSettings and PanelState, and
+// say what else they want in UiRequests; the viewer does the rest.
+#include "ui/settings.h"
+
+namespace pdflab::ui {
+
+// Background of the side panel as RGB: the panel draws none, the viewer
+// clears the panel's rectangle to it.
+inline constexpr float kPanelBackground[3] = {0.11f, 0.11f, 0.125f};
+
+// The side panel, `width` wide at the right edge of a display `display_height` high
+// (ImGui coordinates).
+void draw_side_panel(float width, float display_height, ViewerSettings& settings, PanelState& state,
+                     const UiStatus& status, UiRequests& requests);
+
+// Keys and what they do, centred over the image area.
+void draw_help_overlay(PanelState& state, float area_width, float area_height);
+
+// A short line over the image (preview, paused, biased), top-left of the image area.
+void draw_image_badges(const ViewerSettings& settings, const UiStatus& status);
+
+}  // namespace pdflab::ui

@@ -1,0 +1,108 @@
+#include "ui/screenshot.h"
+
+#include "renderer/error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fcntl.h>
+#include <unistd.h>
+
+namespace pdflab::ui {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void write_text(const std::string& path, const std::string& text) {
+  write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+void write_all(const ScreenshotData& d, const SavedScreenshot& paths) {
+  const float exposure = std::exp2(d.exposure_ev);
+  write_file_atomic(paths.png, encode_png(d.rgb, d.width, d.height, d.transfer, exposure));
+  write_file_atomic(paths.pfm, encode_pfm(d.rgb, d.width, d.height));
+  write_text(paths.json, screenshot_sidecar(d, paths));
+}
+
+void remove_quietly(const std::string& path) {
+  std::error_code ec;
+  fs::remove(path, ec);
+}
+
+}  // namespace
+
+std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& paths) {
+  nlohmann::json j;
+  j["scene"] = d.scene_name;
+  j["scene_file"] = d.scene_file;
+  j["strategy"] = d.strategy.to_string();
+  j["unbiased"] = d.strategy.is_unbiased();
+  double total = 0.0;
+  for (float w : d.strategy.weights) total += w;
+  nlohmann::json weights = nlohmann::json::object();
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (d.strategy.weights[i] > 0.0f)
+      weights[std::string(technique_name(static_cast<Technique>(i)))] = d.strategy.weights[i] / total;
+  j["weights"] = weights;
+  j["width"] = d.width;
+  j["height"] = d.height;
+  j["spp"] = d.spp;
+  j["seconds"] = d.seconds;
+  j["seed"] = d.seed;
+  j["max_depth"] = d.max_depth;
+  j["exposure_ev"] = d.exposure_ev;
+  j["transfer"] = d.transfer == Transfer::Gamma2 ? "gamma2" : "srgb";
+  j["png"] = fs::path(paths.png).filename().string();
+  j["pfm"] = fs::path(paths.pfm).filename().string();
+  j["version"] = d.version;
+  return j.dump(2) + "\n";
+}
+
+SavedScreenshot save_screenshot_in(const std::string& folder, const ScreenshotData& data, std::time_t when) {
+  if (folder.empty()) throw InputError("the screenshot folder is empty");
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw IoError("cannot create screenshot folder '" + folder + "': " + ec.message());
+
+  char stamp[32];
+  std::tm local{};
+  localtime_r(&when, &local);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
+
+  for (int n = 1; n < 100000; ++n) {
+    const std::string stem = (fs::path(folder) / ("pdflab-" + std::string(stamp) + "-" + std::to_string(n))).string();
+    SavedScreenshot paths{stem + ".png", stem + ".pfm", stem + ".json"};
+    if (fs::exists(paths.png, ec) || fs::exists(paths.pfm, ec)) continue;
+    // O_EXCL makes the JSON name a lock: whoever creates it owns the stem.
+    const int fd = ::open(paths.json.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      if (errno == EEXIST) continue;
+      throw IoError("cannot save a screenshot in '" + folder + "': " + std::strerror(errno));
+    }
+    ::close(fd);
+    try {
+      write_all(data, paths);
+    } catch (...) {
+      remove_quietly(paths.png);
+      remove_quietly(paths.pfm);
+      remove_quietly(paths.json);
+      throw;
+    }
+    return paths;
+  }
+  throw IoError("no free screenshot name in '" + folder + "'");
+}
+
+SavedScreenshot save_screenshot_as(const std::string& png_path, const ScreenshotData& data) {
+  fs::path stem = png_path;
+  stem.replace_extension();
+  SavedScreenshot paths{png_path, stem.string() + ".pfm", stem.string() + ".json"};
+  write_all(data, paths);
+  return paths;
+}
+
+}  // namespace pdflab::ui

@@ -1,0 +1,59 @@
+#include "ui/settings.h"
+
+namespace pdflab::ui {
+
+Strategy SamplingSettings::strategy() const {
+  if (!mixture) return Strategy::single(single);
+  Strategy s;
+  s.weights = weights;
+  return s;
+}
+
+SamplingSettings SamplingSettings::from(const Strategy& strategy) {
+  SamplingSettings out;
+  int used = 0;
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (strategy.weights[i] > 0.0f) {
+      ++used;
+      out.single = static_cast<Technique>(i);
+    }
+  out.mixture = used != 1;
+  out.weights = strategy.weights;
+  if (!out.mixture) out.weights[static_cast<int>(out.single)] = 1.0f;
+  return out;
+}
+
+std::array<float, kTechniqueCount> SamplingSettings::normalised() const {
+  const std::array<float, kTechniqueCount> w = strategy().weights;
+  double total = 0.0;
+  for (float x : w) total += x;
+  std::array<float, kTechniqueCount> out{};
+  if (!(total > 0.0)) return out;
+  for (int i = 0; i < kTechniqueCount; ++i) out[i] = static_cast<float>(w[i] / total);
+  return out;
+}
+
+const char* preset_label(Preset p) {
+  switch (p) {
+    case Preset::CosineOnly: return "cosine only";
+    case Preset::LightOnly: return "light only";
+    case Preset::Book5050: return "book 50/50";
+  }
+  return "?";
+}
+
+SamplingSettings preset_sampling(Preset p) {
+  switch (p) {
+    case Preset::CosineOnly: return SamplingSettings::from(Strategy::single(Technique::Cosine));
+    case Preset::LightOnly: return SamplingSettings::from(Strategy::single(Technique::Light));
+    case Preset::Book5050: break;
+  }
+  // The book's final image: half cosine, half towards the importance targets.
+  SamplingSettings s;
+  s.mixture = true;
+  s.weights[static_cast<int>(Technique::Cosine)] = 0.5f;
+  s.weights[static_cast<int>(Technique::Light)] = 0.5f;
+  return s;
+}
+
+}  // namespace pdflab::ui

@@ -1,0 +1,90 @@
+#pragma once
+// The viewer's state as plain data. Panels edit it and raise requests; the
+// viewer turns it into RenderSettings. Nothing here touches threads or OpenGL.
+#include "renderer/sampling/strategy.h"
+#include "renderer/session/session.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pdflab::ui {
+
+// The strategy as the panel edits it: one technique, or a mixture with one
+// slider per technique (raw weights; the renderer normalises them).
+struct SamplingSettings {
+  bool mixture = true;
+  Technique single = Technique::Cosine;
+  std::array<float, kTechniqueCount> weights{};
+
+  Strategy strategy() const;
+  static SamplingSettings from(const Strategy& strategy);
+  // Weights as the renderer will use them (sum 1), or all zero when they sum to 0.
+  std::array<float, kTechniqueCount> normalised() const;
+  bool operator==(const SamplingSettings&) const = default;
+};
+
+enum class Preset { CosineOnly = 1, LightOnly = 2, Book5050 = 3 };
+inline constexpr int kPresetCount = 3;
+const char* preset_label(Preset p);
+SamplingSettings preset_sampling(Preset p);
+
+struct ViewerSettings {
+  SamplingSettings sampling;
+  int max_depth = 50;
+  std::uint64_t seed = 1;
+  float resolution_scale = 1.0f;
+  bool paused = false;
+  std::uint32_t stop_spp = 0;  // 0: render until stopped
+  float exposure_ev = 0.0f;
+  bool srgb = false;  // false: the book's gamma 2
+  std::string screenshot_dir = "screenshots";
+};
+
+inline constexpr std::array<float, 5> kResolutionScales = {0.25f, 0.5f, 1.0f, 1.5f, 2.0f};
+
+// What the panels ask for this frame, beyond edits to ViewerSettings.
+struct UiRequests {
+  bool restart_render = false;  // sampling, depth, seed or resolution changed, or "Restart"
+  bool stop_changed = false;
+  bool pause_changed = false;
+  bool screenshot = false;
+  bool retry_screenshot = false;
+  std::string load_scene;  // non-empty: try this file
+};
+
+struct Notice {
+  std::string text;
+  bool error = false;
+  double shown_at = 0.0;  // seconds, on the viewer's clock
+};
+
+// Read-only facts the panels show.
+struct UiStatus {
+  SessionStats stats;
+  int threads = 0;
+  std::string scene_name;
+  std::string scene_path;
+  int base_width = 0, base_height = 0;  // the scene's own resolution
+  int width = 0, height = 0;            // rendered resolution
+  std::vector<std::string> scene_files;  // assets/scenes/*.json
+  std::string scene_error;               // last failed load, empty when fine
+  std::string settings_error;            // strategy not usable on this scene, ...
+  bool showing_preview = false;
+  std::uint32_t shown_spp = 0;
+  bool screenshot_pending = false;  // waiting for a full pass or for the writer
+  bool can_retry_screenshot = false;
+  Notice notice;
+  double now = 0.0;
+  double frame_ms = 0.0;
+};
+
+// Text-field buffers and other panel-local state that is not a setting.
+struct PanelState {
+  std::string scene_path_field;
+  bool show_help = false;
+  bool scene_field_initialised = false;
+};
+
+}  // namespace pdflab::ui
