@@ -62,15 +62,14 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   Result r;
   r.strategy = strategy;
   std::vector<float> image;
-  int w = 0, h = 0;
   std::uint64_t version = 0;
   for (;;) {
     const bool done = session.wait_until_done(std::chrono::milliseconds(25));
     SessionStats st = session.stats();
-    if (session.copy_image(image, w, h, version)) {
-      const SessionStats at = session.stats();  // the image is the last complete pass
-      r.curve.push_back({at.spp, at.seconds, rmse(image, reference), relmse(image, reference)});
-    }
+    ImageInfo info;
+    // The info describes the very image copied (its pass's spp and time); previews are not estimates.
+    if (session.copy_image(image, info, version) && !info.preview && info.spp > 0)
+      r.curve.push_back({info.spp, info.seconds, rmse(image, reference), relmse(image, reference)});
     if (show_progress) {
       const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
       std::fprintf(stderr, "\r%s %-32s %5.1f%%  %u spp  %.1f s   ", progress_prefix.c_str(),
