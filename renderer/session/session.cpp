@@ -26,6 +26,9 @@ RenderSession::~RenderSession() {
 void RenderSession::set_settings(RenderSettings settings) {
   if (!settings.scene) throw std::invalid_argument("RenderSession: settings without a scene");
   const SamplingPlan plan = SamplingPlan::make(settings.strategy, *settings.scene);  // may throw InputError
+  // The film is resized by whichever thread applies the settings, possibly a
+  // worker: refuse an oversized image here, where the caller can catch it.
+  check_image_size(settings.scene->camera.width, settings.scene->camera.height, "camera");
   {
     std::lock_guard lk(mutex_);
     generation_.fetch_add(1);
