@@ -196,6 +196,10 @@ SessionStats RenderSession::stats() const {
   std::lock_guard lk(mutex_);
   SessionStats st;
   st.generation = generation_.load();
+  st.paused = paused_;
+  // New settings wait for the workers to leave the old pass; until then the
+  // counters below still describe the old render. The new one has nothing yet.
+  if (pending_) return st;
   st.spp = spp_done_;
   st.seconds = elapsed_locked();
   std::uint64_t partial = 0;
@@ -210,7 +214,6 @@ SessionStats RenderSession::stats() const {
   st.done = target != 0 && spp_done_ >= target && !pending_;
   if (target != 0) st.progress = std::min(1.0, (spp_done_ + pass_fraction * pass_.spp) / target);
   st.dropped = drops_;
-  st.paused = paused_;
   return st;
 }
 
