@@ -1,5 +1,6 @@
 // libFuzzer target for the scene loader (scripts/fuzz.sh builds and runs it).
-// Any input must either load or be refused with an InputError; any other
+// Any input must either load or be refused with an InputError whose message is
+// one printable line starting with the origin; any other
 // exception, a sanitizer report, a hang or a scene that loads but breaks an
 // invariant the renderer relies on is a finding. A scene that loads also
 // renders a few samples, so that the loader's validation is checked against
@@ -52,6 +53,24 @@ void check_loaded(const pdflab::Scene& scene) {
   }
 }
 
+// A message is one line of valid UTF-8 without control bytes: it goes to a terminal.
+bool printable_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      if (c < 0x20 || c == 0x7f) return false;
+      ++i;
+      continue;
+    }
+    const std::size_t n = (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3 : (c & 0xF8) == 0xF0 ? 4 : 0;
+    if (n == 0 || i + n > s.size() || c == 0xC0 || c == 0xC1 || c > 0xF4) return false;
+    for (std::size_t k = 1; k < n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return false;
+    i += n;
+  }
+  return true;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -60,7 +79,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     scene = pdflab::load_scene_text(text, "fuzz");
   } catch (const pdflab::InputError& e) {
-    if (std::string(e.what()).rfind("fuzz: ", 0) != 0) broken("message does not start with the origin");
+    const std::string message = e.what();
+    if (message.rfind("fuzz: ", 0) != 0) broken("message does not start with the origin");
+    if (!printable_utf8(message)) broken("message with a control byte or invalid UTF-8");
     return 0;
   }
   check_loaded(scene);
