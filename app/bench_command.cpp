@@ -119,9 +119,7 @@ int run_bench(const BenchOptions& o) {
   check_output_path(o.csv);
   if (!o.plot.empty()) check_output_path(o.plot);
   if (!o.curves.empty()) check_output_path(o.curves);
-  // Two outputs on one path would silently keep only the last one written.
-  if (o.csv == o.plot || o.csv == o.curves || (!o.plot.empty() && o.plot == o.curves))
-    throw InputError("--csv, --plot and --curves must name different files");
+  check_distinct_outputs({o.csv, o.plot, o.curves});
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);

@@ -7,6 +7,8 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -24,6 +26,21 @@ constexpr int kInternalFailure = 1;
 int report_input_error(const std::string& what) {
   std::fprintf(stderr, "pdflab: error: %s\n", what.c_str());
   return kBadInput;
+}
+
+// CLI11 wraps "-1" around and saturates a too large number when it converts
+// them to an unsigned option; both are typing mistakes, so check first.
+CLI::Validator non_negative_integer() {
+  return CLI::Validator(
+      [](std::string& value) {
+        std::uint64_t parsed = 0;
+        const char* end = value.data() + value.size();
+        const auto [ptr, ec] = std::from_chars(value.data(), end, parsed);
+        if (value.empty() || ec != std::errc() || ptr != end)
+          return "must be an integer in 0.." + std::to_string(UINT64_MAX) + ", not '" + value + "'";
+        return std::string();
+      },
+      "UINT64");
 }
 
 }  // namespace
@@ -49,7 +66,8 @@ int main(int argc, char** argv) {
       ->required();
   render->add_option("--spp", ro.spp, "Samples per pixel")->required()->check(CLI::Range(1u, 1u << 30));
   render->add_option("--out", ro.out, "Output image: .png (tone-mapped), .pfm (linear), .hdr")->required();
-  render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)");
+  render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)")
+      ->check(non_negative_integer());
   render->add_option("--threads", ro.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   render->add_option("--width", ro.width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   render->add_option("--height", ro.height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
@@ -79,7 +97,8 @@ int main(int argc, char** argv) {
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
   bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
-  bench->add_option("--seed", bo.seed, "Random seed (default 2; use one the reference was not rendered with)");
+  bench->add_option("--seed", bo.seed, "Random seed (default 2; use one the reference was not rendered with)")
+      ->check(non_negative_integer());
   bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   bench->add_flag("--quiet", bo.quiet, "No progress line");
 

@@ -1,6 +1,7 @@
 #include "app/render_command.h"
 
 #include "renderer/error.h"
+#include "renderer/film/film.h"
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
@@ -37,6 +38,7 @@ int run_render(const RenderOptions& o) {
   (void)format;
   check_output_path(o.out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
+  check_distinct_outputs({o.out, o.stats_json});
   Transfer transfer;
   if (o.transfer == "gamma2") transfer = Transfer::Gamma2;
   else if (o.transfer == "srgb") transfer = Transfer::Srgb;
@@ -46,6 +48,7 @@ int run_render(const RenderOptions& o) {
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   if (o.width != 0) scene->camera.width = o.width;
   if (o.height != 0) scene->camera.height = o.height;
+  if (o.width != 0 || o.height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
   scene->prepare();
   const Strategy strategy = Strategy::parse(o.strategy);
   (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too

@@ -8,6 +8,7 @@ packages=(
   libglfw3-dev libimgui-dev libglm-dev libstb-dev python3-glad python3-jinja2
   nlohmann-json3-dev libcli11-dev libpcg-cpp-dev
   libgtest-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev   # the fuzzer: clang's libFuzzer and sanitizer runtimes (a recommend, not a dependency)
   xvfb xauth mesa-utils libgl1-mesa-dri xdotool imagemagick x11-apps
 )
 

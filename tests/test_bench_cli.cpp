@@ -280,7 +280,7 @@ TEST_F(BenchCommand, OutputsMustBeWritableAndDistinct) {
   expect_bad_input(args, "does not exist");
   args.back() = in_work("out.csv");
   args.insert(args.end(), {"--plot", in_work("out.csv")});
-  expect_bad_input(args, "different files");
+  expect_bad_input(args, "named twice");
 }
 
 TEST_F(BenchCommand, UnreadableSceneIsBadInput) {

@@ -332,12 +332,25 @@ TEST(SceneValidation, ImageSizeRange) {
     doc["camera"]["height"] = w;
     expect_error_mentions(doc, {"camera.height:", "1..16384"});
   }
-  // The limits themselves are valid.
-  for (int w : {1, 16384}) {
+  // The limits themselves are valid: 1, 16384 per side, and exactly the pixel budget.
+  for (const auto& [w, h] : {std::pair{1, 1}, std::pair{16384, 1}, std::pair{1, 16384}, std::pair{16384, 1024},
+                             std::pair{4096, 4096}}) {
     json doc = minimal_scene();
     doc["camera"]["width"] = w;
-    doc["camera"]["height"] = w;
-    EXPECT_NO_THROW((void)load_scene_text(doc.dump(), "scene.json")) << w;
+    doc["camera"]["height"] = h;
+    EXPECT_NO_THROW((void)load_scene_text(doc.dump(), "scene.json")) << w << "x" << h;
+  }
+}
+
+TEST(SceneValidation, PixelBudgetIsEnforcedBeforeAllocation) {
+  // Both sides in range, but 16384 x 16384 would need 13 GiB of film.
+  for (const auto& [w, h] : {std::pair{16384, 16384}, std::pair{4097, 4096}, std::pair{16384, 1025}}) {
+    json doc = minimal_scene();
+    doc["camera"]["width"] = w;
+    doc["camera"]["height"] = h;
+    expect_error_mentions(doc, {"camera:", "more than the limit of 16777216", "GiB"});
+    const std::string size = std::to_string(w) + "x" + std::to_string(h);
+    EXPECT_NE(load_error(doc.dump()).find(size), std::string::npos) << size;
   }
 }
 

@@ -1,10 +1,31 @@
 #include "renderer/film/film.h"
 
+#include "renderer/error.h"
+
 #include <algorithm>
+#include <cstdio>
 
 namespace pdflab {
 
+std::string image_size_problem(std::int64_t width, std::int64_t height) {
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  if (width < 1 || width > kMaxImageSide || height < 1 || height > kMaxImageSide)
+    return "image size " + size + " is outside 1.." + std::to_string(kMaxImageSide) + " per side";
+  const std::int64_t pixels = width * height;
+  if (pixels <= kMaxImagePixels) return {};
+  char gib[32];
+  std::snprintf(gib, sizeof gib, "%.1f", static_cast<double>(pixels * kFilmBytesPerPixel) / (1 << 30));
+  return "image size " + size + " has " + std::to_string(pixels) + " pixels, more than the limit of " +
+         std::to_string(kMaxImagePixels) + " (4096x4096); its film alone would need " + gib + " GiB";
+}
+
+void check_image_size(std::int64_t width, std::int64_t height, const std::string& what) {
+  const std::string problem = image_size_problem(width, height);
+  if (!problem.empty()) throw InputError(what + ": " + problem);
+}
+
 void Film::reset(int width, int height) {
+  check_image_size(width, height, "film");
   width_ = width;
   height_ = height;
   sum_.assign(3 * pixel_count(), 0.0);

@@ -5,9 +5,25 @@
 #include "renderer/math.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace pdflab {
+
+// Image size limits. A side may be up to 16384 pixels, but the film costs
+// kFilmBytesPerPixel (sum and sum of squares in double, a count) and a render
+// holds about as much again in float images (the published pass, the copy that
+// is written, the encoded file), so 16384 x 16384 would need about 25 GiB.
+// The pixel budget caps a render near 2 GiB: 4096 x 4096, 8192 x 2048, ...
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 24;
+inline constexpr std::int64_t kFilmBytesPerPixel = 6 * sizeof(double) + sizeof(std::uint32_t);
+
+// Empty when width x height is within 1..kMaxImageSide per side and at most
+// kMaxImagePixels; otherwise what is wrong, with the memory it would take.
+std::string image_size_problem(std::int64_t width, std::int64_t height);
+// Throws InputError "what: problem". Called before anything of that size is allocated.
+void check_image_size(std::int64_t width, std::int64_t height, const std::string& what);
 
 class Film {
  public:

@@ -1,6 +1,7 @@
 #include "renderer/film/image_io.h"
 
 #include "renderer/error.h"
+#include "renderer/film/film.h"
 
 #include <stb_image_write.h>
 #include <unistd.h>
@@ -38,6 +39,19 @@ void check_output_path(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0)
     throw InputError("output file '" + path + "': folder '" + dir.string() + "' is not writable");
   if (fs::is_directory(path, ec)) throw InputError("output file '" + path + "' is a folder");
+}
+
+void check_distinct_outputs(const std::vector<std::string>& paths) {
+  std::vector<fs::path> seen;
+  for (const std::string& p : paths) {
+    if (p.empty()) continue;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(fs::absolute(p, ec), ec);
+    if (ec) canonical = fs::path(p).lexically_normal();
+    if (std::find(seen.begin(), seen.end(), canonical) != seen.end())
+      throw InputError("output file '" + p + "' is named twice; each output needs its own file");
+    seen.push_back(std::move(canonical));
+  }
 }
 
 void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes) {
@@ -130,9 +144,20 @@ std::vector<float> read_pfm(const std::string& path, int& width, int& height) {
   double scale = 0.0;
   long w = 0, h = 0;
   in >> magic >> w >> h >> scale;
-  if (!in || magic != "PF" || w <= 0 || h <= 0 || w > 16384 || h > 16384 || scale == 0.0)
+  if (!in || magic != "PF" || w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide || scale == 0.0)
     throw InputError("'" + path + "' is not a colour PFM image (expected 'PF', width, height, scale)");
+  if (const std::string problem = image_size_problem(w, h); !problem.empty())
+    throw InputError("'" + path + "': " + problem);
   in.get();  // the single whitespace byte after the scale
+  // A header can claim any size: compare with the file before allocating.
+  const std::streamoff data_start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff file_size = in.tellg();
+  in.seekg(data_start);
+  const auto needed = static_cast<std::streamoff>(w) * h * 3 * static_cast<std::streamoff>(sizeof(float));
+  if (data_start < 0 || file_size < 0 || file_size - data_start < needed)
+    throw InputError("'" + path + "': PFM data is truncated (the header says " + std::to_string(w) + "x" +
+                     std::to_string(h) + ")");
   width = static_cast<int>(w);
   height = static_cast<int>(h);
   const std::size_t row = static_cast<std::size_t>(w) * 3;

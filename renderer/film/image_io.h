@@ -17,6 +17,10 @@ ImageFormat image_format_for(const std::string& path);
 // Throws InputError when the folder of `path` does not exist or is not writable.
 void check_output_path(const std::string& path);
 
+// Throws InputError when two of `paths` (empty ones ignored) name the same
+// file: the second write would replace the first.
+void check_distinct_outputs(const std::vector<std::string>& paths);
+
 // Throws IoError (with the path and the system's reason) on failure; the target
 // is then untouched.
 void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes);

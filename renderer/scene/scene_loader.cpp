@@ -1,15 +1,17 @@
 #include "renderer/scene/scene_loader.h"
 
 #include "renderer/error.h"
+#include "renderer/film/film.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 namespace pdflab {
 
@@ -17,7 +19,49 @@ using json = nlohmann::json;
 
 namespace {
 
-constexpr int kMaxImageSide = 16384;
+// A scene is a few kilobytes; this bounds what a wrong path (a disk image,
+// /dev/zero) can make the loader read into memory.
+constexpr std::size_t kMaxSceneBytes = std::size_t{64} << 20;
+
+// Messages go to a terminal: control bytes and invalid UTF-8 from a binary
+// file or a JSON string (unknown key "\n...") become \xNN, valid UTF-8 stays.
+std::string printable(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  const auto escape = [&](unsigned char c) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "\\x%02X", c);
+    out += buf;
+  };
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // Length of a well-formed UTF-8 sequence starting here (0: none).
+    std::size_t n = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    if (n > 0 && i + n <= s.size()) {
+      for (std::size_t k = 1; k < n; ++k)
+        if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) n = 0;
+      // Overlong three- and four-byte forms, surrogates and code points past U+10FFFF.
+      const auto c1 = n > 0 ? static_cast<unsigned char>(s[i + 1]) : 0;
+      if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 >= 0xA0) || (c == 0xF0 && c1 < 0x90) || (c == 0xF4 && c1 >= 0x90))
+        n = 0;
+    } else {
+      n = 0;
+    }
+    if (n == 0) {
+      escape(c);
+      ++i;
+    } else {
+      out.append(s, i, n);
+      i += n;
+    }
+  }
+  return out;
+}
 
 // A JSON value with the path that leads to it, for error messages.
 class Node {
@@ -101,6 +145,7 @@ void parse_camera(const Node& node, Scene& scene) {
   Camera& cam = scene.camera;
   cam.width = node.require("width").integer(1, kMaxImageSide);
   cam.height = node.require("height").integer(1, kMaxImageSide);
+  if (const std::string problem = image_size_problem(cam.width, cam.height); !problem.empty()) node.fail(problem);
   const Node vfov = node.require("vfov");
   cam.vfov_degrees = vfov.real();
   if (!(cam.vfov_degrees > 0.0f && cam.vfov_degrees < 180.0f)) vfov.fail("must be between 0 and 180 degrees (exclusive)");
@@ -228,7 +273,11 @@ std::string line_and_column(const std::string& text, std::size_t byte) {
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& origin) {
+namespace {
+
+Scene parse_scene(const std::string& text, const std::string& origin) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(origin + ": the scene is empty (expected a JSON object)");
   json doc;
   try {
     doc = json::parse(text);
@@ -280,13 +329,32 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
   return scene;
 }
 
+}  // namespace
+
+Scene load_scene_text(const std::string& text, const std::string& origin) {
+  try {
+    return parse_scene(text, origin);
+  } catch (const InputError& e) {
+    throw InputError(printable(e.what()));
+  }
+}
+
 Scene load_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(printable("cannot read scene '" + path + "': it is a folder, not a file"));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read scene '" + path + "': " + std::strerror(errno));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw InputError("cannot read scene '" + path + "': read error");
-  return load_scene_text(buffer.str(), path);
+  if (!in) throw InputError(printable("cannot read scene '" + path + "': " + std::strerror(errno)));
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxSceneBytes)
+      throw InputError(printable("cannot read scene '" + path + "': larger than " +
+                                 std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?"));
+  }
+  if (in.bad()) throw InputError(printable("cannot read scene '" + path + "': read error"));
+  return load_scene_text(text, path);
 }
 
 }  // namespace pdflab

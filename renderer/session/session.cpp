@@ -34,6 +34,9 @@ RenderSession::~RenderSession() {
 void RenderSession::set_settings(RenderSettings settings) {
   if (!settings.scene) throw std::invalid_argument("RenderSession: settings without a scene");
   const SamplingPlan plan = SamplingPlan::make(settings.strategy, *settings.scene);  // may throw InputError
+  // The film is resized by whichever thread applies the settings, possibly a
+  // worker: refuse an oversized image here, where the caller can catch it.
+  check_image_size(settings.scene->camera.width, settings.scene->camera.height, "camera");
   {
     std::lock_guard lk(mutex_);
     generation_.fetch_add(1);
@@ -292,6 +295,10 @@ SessionStats RenderSession::stats() const {
   std::lock_guard lk(mutex_);
   SessionStats st;
   st.generation = generation_.load();
+  st.paused = paused_;
+  // New settings wait for the workers to leave the old pass; until then the
+  // counters below still describe the old render. The new one has nothing yet.
+  if (pending_) return st;
   st.spp = spp_done_;
   st.seconds = elapsed_locked();
   std::uint64_t partial = 0;
@@ -306,7 +313,6 @@ SessionStats RenderSession::stats() const {
   st.done = target != 0 && spp_done_ >= target && !pending_;
   if (target != 0) st.progress = std::min(1.0, (spp_done_ + pass_fraction * pass_.spp) / target);
   st.dropped = drops_;
-  st.paused = paused_;
   return st;
 }
 

@@ -78,7 +78,8 @@ class RenderSession {
   RenderSession& operator=(const RenderSession&) = delete;
 
   // Starts (or restarts) rendering with these settings. Throws InputError when
-  // the strategy cannot be used on the scene; the running render then goes on.
+  // the strategy cannot be used on the scene or the image is too large
+  // (check_image_size); the running render then goes on.
   void set_settings(RenderSettings settings);
   RenderSettings settings() const;
   void set_paused(bool paused);

@@ -1,0 +1,103 @@
+#pragma once
+// Runs the pdflab binary as a child process for the reliability tests: no
+// shell, stdin from /dev/null, stdout and stderr captured to files, a working
+// folder, a wall-clock deadline after which the child is killed, and an
+// optional file-size limit (RLIMIT_FSIZE) to simulate a full disk.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace pdflab::testing {
+
+struct ChildResult {
+  bool started = false;
+  bool exited = false;     // false: killed by a signal (or by the deadline)
+  bool timed_out = false;  // killed by the deadline
+  int status = -1;         // exit status when exited
+  double seconds = 0.0;    // wall time
+  std::string out, err;
+};
+
+struct ChildOptions {
+  std::filesystem::path cwd;              // the child's working folder
+  std::filesystem::path capture;          // where stdout/stderr files go (not cwd)
+  double deadline_seconds = 10.0;
+  long long file_size_limit = -1;         // bytes; -1: unlimited
+};
+
+inline std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline ChildResult run_pdflab(const std::vector<std::string>& args, const ChildOptions& o) {
+  const std::string out_path = (o.capture / "stdout").string();
+  const std::string err_path = (o.capture / "stderr").string();
+  std::vector<std::string> storage{PDFLAB_BINARY};
+  storage.insert(storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& s : storage) argv.push_back(s.data());
+  argv.push_back(nullptr);
+
+  ChildResult r;
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = ::fork();
+  if (pid < 0) return r;
+  if (pid == 0) {
+    // Only async-signal-safe calls from here to exec.
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || err < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(err, 2) < 0) ::_exit(126);
+    if (!o.cwd.empty() && ::chdir(o.cwd.c_str()) != 0) ::_exit(126);
+    if (o.file_size_limit >= 0) {
+      ::signal(SIGXFSZ, SIG_IGN);  // the write fails with EFBIG, as with ENOSPC, instead of killing
+      const rlimit limit{static_cast<rlim_t>(o.file_size_limit), static_cast<rlim_t>(o.file_size_limit)};
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(126);
+    }
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  r.started = true;
+  int status = 0;
+  for (;;) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (elapsed > o.deadline_seconds && !r.timed_out) {
+      r.timed_out = true;
+      ::kill(pid, SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.exited = WIFEXITED(status) && !r.timed_out;
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out_path);
+  r.err = slurp(err_path);
+  return r;
+}
+
+// Every path under `root`, relative and sorted: "nothing was written" is a
+// comparison of two listings.
+inline std::vector<std::string> listing(const std::filesystem::path& root) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (auto it = std::filesystem::recursive_directory_iterator(root, ec); !ec && it != decltype(it)(); it.increment(ec))
+    names.push_back(std::filesystem::relative(it->path(), root).string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace pdflab::testing
