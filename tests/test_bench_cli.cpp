@@ -1,11 +1,9 @@
 // `pdflab bench` on the real binary: every class of bad input exits 2 with a
 // message naming the problem and writes nothing; a tiny run writes a CSV with
 // the documented columns, a curves CSV and a well-formed SVG plot.
+#include "tests/support.h"
+
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,28 +17,19 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
-
 namespace {
 
 namespace fs = std::filesystem;
 
 const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json";
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
 }
 
-struct RunResult {
-  int status = -1;  // exit status; -1 when killed by a signal
-  std::string out, err;
-};
+using pdflab::testing::ChildResult;
+using pdflab::testing::slurp;
 
 std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> parts;
@@ -147,65 +136,28 @@ std::vector<std::map<std::string, std::string>> parse_csv(const std::string& tex
 class BenchCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "pdflab-bench-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
     fs::create_directory(work());
-    fs::create_directory(root_ / "io");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(root_, ec);
+    fs::create_directory(root_.path() / "io");
   }
 
-  fs::path work() const { return root_ / "work"; }
+  fs::path work() const { return root_.path() / "work"; }
   std::string in_work(const std::string& name) const { return (work() / name).string(); }
-
-  std::vector<std::string> work_entries() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(work())) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
+  std::vector<std::string> work_entries() const { return pdflab::testing::listing(work()); }
 
   // The binary itself (no shell), stdin from /dev/null, in the work folder.
-  RunResult run(const std::vector<std::string>& args) const {
-    const std::string out_path = (root_ / "io" / "stdout").string();
-    const std::string err_path = (root_ / "io" / "stderr").string();
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addchdir_np(&actions, work().c_str());
-    std::vector<std::string> storage = {PDFLAB_BINARY};
-    storage.insert(storage.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& s : storage) argv.push_back(s.data());
-    argv.push_back(nullptr);
-
-    RunResult r;
-    pid_t pid = 0;
-    const int rc = ::posix_spawn(&pid, PDFLAB_BINARY, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) {
-      ADD_FAILURE() << "posix_spawn failed: " << std::strerror(rc);
-      return r;
-    }
-    int status = 0;
-    if (::waitpid(pid, &status, 0) != pid) {
-      ADD_FAILURE() << "waitpid failed";
-      return r;
-    }
-    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = read_text(out_path);
-    r.err = read_text(err_path);
+  ChildResult run(const std::vector<std::string>& args) const {
+    pdflab::testing::ChildOptions o;
+    o.cwd = work();
+    o.capture = root_.path() / "io";
+    o.deadline_seconds = 120.0;
+    const ChildResult r = pdflab::testing::run_pdflab(args, o);
+    if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
     return r;
   }
 
   // A non-square reference, so a swapped width and height would show.
   void make_reference(const std::string& name = "ref.pfm") const {
-    const RunResult r = run({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp", "256",
+    const ChildResult r = run({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp", "256",
                              "--width", "12", "--height", "8", "--threads", "2", "--quiet", "--out", in_work(name)});
     ASSERT_EQ(r.status, 0) << r.err;
   }
@@ -221,7 +173,7 @@ class BenchCommand : public ::testing::Test {
   // Exit 2, one message containing `needle`, and the work folder as it was.
   void expect_bad_input(const std::vector<std::string>& args, const std::string& needle) const {
     const std::vector<std::string> before = work_entries();
-    const RunResult r = run(args);
+    const ChildResult r = run(args);
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(needle), std::string::npos) << "message lacks '" << needle << "': " << r.err;
@@ -230,7 +182,7 @@ class BenchCommand : public ::testing::Test {
   }
 
  private:
-  fs::path root_;
+  pdflab::testing::TempDir root_{"pdflab-bench"};
 };
 
 TEST_F(BenchCommand, MissingReferenceIsBadInput) {
@@ -296,15 +248,15 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
   // terminal, so there is no progress line either way).
   std::vector<std::string> args = bench_args({"--strategies", "cosine;light;mix:cosine=0.5,light=0.5", "--spp", "16"});
   args.erase(std::find(args.begin(), args.end(), "--quiet"));
-  const RunResult r = run(args);
+  const ChildResult r = run(args);
   ASSERT_EQ(r.status, 0) << r.err;
 
   std::vector<std::string> header;
-  const auto rows = parse_csv(read_text(work() / "out.csv"), header);
+  const auto rows = parse_csv(slurp(work() / "out.csv"), header);
   const std::vector<std::string> required = {"strategy", "spp", "seconds", "rmse", "relmse",
                                              "efficiency", "samples_per_second", "dropped"};
   ASSERT_GE(header.size(), required.size());
-  EXPECT_TRUE(std::equal(required.begin(), required.end(), header.begin())) << read_text(work() / "out.csv");
+  EXPECT_TRUE(std::equal(required.begin(), required.end(), header.begin())) << slurp(work() / "out.csv");
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0].at("strategy"), "cosine");
   EXPECT_EQ(rows[1].at("strategy"), "light");
@@ -333,14 +285,14 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
   EXPECT_NE(r.out.find("(biased)"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("'light' is biased"), std::string::npos) << r.err;
 
-  const std::string svg = read_text(work() / "out.svg");
+  const std::string svg = slurp(work() / "out.svg");
   EXPECT_TRUE(well_formed_xml(svg));
   EXPECT_NE(svg.find("<svg"), std::string::npos);
   EXPECT_NE(svg.find("light (biased)"), std::string::npos);
   EXPECT_NE(svg.find("mix:cosine=0.5,light=0.5"), std::string::npos);
 
   std::vector<std::string> curve_header;
-  const auto curve = parse_csv(read_text(work() / "curves.csv"), curve_header);
+  const auto curve = parse_csv(slurp(work() / "curves.csv"), curve_header);
   EXPECT_EQ(curve_header, (std::vector<std::string>{"strategy", "spp", "seconds", "rmse", "relmse"}));
   ASSERT_FALSE(curve.empty());
   // Each strategy's curve ends at the final spp.
@@ -356,10 +308,10 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
 
 TEST_F(BenchCommand, EqualTimeRunsForAboutTheGivenTime) {
   make_reference();
-  const RunResult r = run(bench_args({"--strategies", "cosine", "--seconds", "0.3"}));
+  const ChildResult r = run(bench_args({"--strategies", "cosine", "--seconds", "0.3"}));
   ASSERT_EQ(r.status, 0) << r.err;
   std::vector<std::string> header;
-  const auto rows = parse_csv(read_text(work() / "out.csv"), header);
+  const auto rows = parse_csv(slurp(work() / "out.csv"), header);
   ASSERT_EQ(rows.size(), 1u);
   // At least the time asked for; the pass in flight when time is up is kept,
   // and passes aim at 30-120 ms, so a loaded machine may add a little.
@@ -370,16 +322,16 @@ TEST_F(BenchCommand, EqualTimeRunsForAboutTheGivenTime) {
 
 TEST_F(BenchCommand, ScenesWithMarkupInTheirNameStillGiveAWellFormedPlot) {
   make_reference();
-  std::string scene = read_text(kBookScene);
+  std::string scene = slurp(kBookScene);
   const std::size_t name = scene.find("\"Cornell box (book)\"");
   ASSERT_NE(name, std::string::npos);
   scene.replace(name, std::string("\"Cornell box (book)\"").size(), "\"A <box> & \\\"quotes\\\"\"");
   write_text(work() / "scene.json", scene);
   std::vector<std::string> args = bench_args({"--strategies", "cosine", "--spp", "2"});
   args[2] = in_work("scene.json");
-  const RunResult r = run(args);
+  const ChildResult r = run(args);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_TRUE(well_formed_xml(read_text(work() / "out.svg")));
+  EXPECT_TRUE(well_formed_xml(slurp(work() / "out.svg")));
 }
 
 }  // namespace

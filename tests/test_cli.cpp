@@ -2,13 +2,10 @@
 // each class of bad input exits 2 with one message naming the problem and
 // writes nothing; a small render writes the image, the stats JSON and a summary.
 #include "renderer/film/image_io.h"
+#include "tests/support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <fcntl.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,8 +20,6 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
-
 namespace pdflab {
 namespace {
 
@@ -33,16 +28,8 @@ namespace fs = std::filesystem;
 const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json";
 const std::string kBadInput = std::string(PDFLAB_SOURCE_DIR) + "/tests/bad_input/";
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-struct RunResult {
-  bool exited = false;  // false: killed by a signal
-  int status = -1;      // exit status when exited
-  std::string out, err;
-};
+using testing::ChildResult;
+using testing::slurp;
 
 // Each test gets an empty working folder (the child's cwd and where outputs
 // go) and a separate folder for the captured streams, so that "nothing was
@@ -50,64 +37,22 @@ struct RunResult {
 class RenderCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "pdflab-cli-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    root_ = pattern;
     fs::create_directory(work());
-    fs::create_directory(root_ / "io");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(root_, ec);
+    fs::create_directory(root_.path() / "io");
   }
 
-  fs::path work() const { return root_ / "work"; }
+  fs::path work() const { return root_.path() / "work"; }
   std::string in_work(const std::string& name) const { return (work() / name).string(); }
-
-  std::vector<std::string> work_entries() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::recursive_directory_iterator(work()))
-      names.push_back(fs::relative(e.path(), work()).string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
+  std::vector<std::string> work_entries() const { return testing::listing(work()); }
 
   // Runs the binary directly (no shell) with stdin from /dev/null.
-  RunResult run(const std::vector<std::string>& args) const {
-    const std::string out_path = (root_ / "io" / "stdout").string();
-    const std::string err_path = (root_ / "io" / "stderr").string();
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addchdir_np(&actions, work().c_str());
-
-    std::vector<std::string> storage;
-    storage.reserve(args.size() + 1);
-    storage.emplace_back(PDFLAB_BINARY);
-    storage.insert(storage.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& s : storage) argv.push_back(s.data());
-    argv.push_back(nullptr);
-
-    RunResult r;
-    pid_t pid = 0;
-    const int rc = ::posix_spawn(&pid, PDFLAB_BINARY, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) {
-      ADD_FAILURE() << "posix_spawn(" << PDFLAB_BINARY << ") failed: " << std::strerror(rc);
-      return r;
-    }
-    int status = 0;
-    if (::waitpid(pid, &status, 0) != pid) {
-      ADD_FAILURE() << "waitpid failed";
-      return r;
-    }
-    r.exited = WIFEXITED(status);
-    r.status = r.exited ? WEXITSTATUS(status) : -1;
-    r.out = read_text(out_path);
-    r.err = read_text(err_path);
+  ChildResult run(const std::vector<std::string>& args) const {
+    testing::ChildOptions o;
+    o.cwd = work();
+    o.capture = root_.path() / "io";
+    o.deadline_seconds = 120.0;
+    const ChildResult r = testing::run_pdflab(args, o);
+    if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
     return r;
   }
 
@@ -137,7 +82,7 @@ class RenderCommand : public ::testing::Test {
     std::string line;
     for (const auto& a : args) line += " " + a;
     SCOPED_TRACE("pdflab" + line);
-    const RunResult r = run(args);
+    const ChildResult r = run(args);
     ASSERT_TRUE(r.exited) << "killed by a signal; stderr:\n" << r.err;
     EXPECT_EQ(r.status, 2) << "stderr:\n" << r.err;
     EXPECT_EQ(r.err.rfind("pdflab: error: ", 0), 0u) << r.err;
@@ -149,12 +94,12 @@ class RenderCommand : public ::testing::Test {
     EXPECT_TRUE(work_entries().empty()) << "files were written: " << ::testing::PrintToString(work_entries());
   }
 
-  fs::path root_;
+  testing::TempDir root_{"pdflab-cli"};
 };
 
 TEST_F(RenderCommand, ValidBaseCommandSucceeds) {
   // Every bad-input test changes one thing in this command: it must work as is.
-  const RunResult r = run(render_args());
+  const ChildResult r = run(render_args());
   ASSERT_TRUE(r.exited);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(work_entries(), std::vector<std::string>{"image.png"});
@@ -228,7 +173,7 @@ std::vector<std::string> small_render(const std::string& out, std::initializer_l
 }
 
 TEST_F(RenderCommand, RendersPfmAndStatsJson) {
-  const RunResult r = run(small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json"), "--seed", "5"}));
+  const ChildResult r = run(small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json"), "--seed", "5"}));
   ASSERT_TRUE(r.exited);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(work_entries(), (std::vector<std::string>{"image.pfm", "stats.json"}));
@@ -244,7 +189,7 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   }
   EXPECT_GT(total / static_cast<double>(rgb.size()), 0.01) << "the Cornell box rendered black";
 
-  const nlohmann::json stats = nlohmann::json::parse(read_text(work() / "stats.json"));
+  const nlohmann::json stats = nlohmann::json::parse(slurp(work() / "stats.json"));
   EXPECT_EQ(stats.at("spp").get<int>(), 4);
   EXPECT_EQ(stats.at("width").get<int>(), 32);
   EXPECT_EQ(stats.at("height").get<int>(), 32);
@@ -272,11 +217,11 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
 }
 
 TEST_F(RenderCommand, RendersPng) {
-  const RunResult r = run(small_render(in_work("image.png")));
+  const ChildResult r = run(small_render(in_work("image.png")));
   ASSERT_TRUE(r.exited);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(work_entries(), std::vector<std::string>{"image.png"});
-  const std::string png = read_text(work() / "image.png");
+  const std::string png = slurp(work() / "image.png");
   ASSERT_GT(png.size(), 24u);
   EXPECT_EQ(png.substr(1, 3), "PNG");
   EXPECT_EQ(png.substr(12, 4), "IHDR");
@@ -292,11 +237,11 @@ TEST_F(RenderCommand, RendersPng) {
 }
 
 TEST_F(RenderCommand, RendersHdr) {
-  const RunResult r = run(small_render(in_work("image.hdr")));
+  const ChildResult r = run(small_render(in_work("image.hdr")));
   ASSERT_TRUE(r.exited);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(work_entries(), std::vector<std::string>{"image.hdr"});
-  const std::string hdr = read_text(work() / "image.hdr");
+  const std::string hdr = slurp(work() / "image.hdr");
   EXPECT_EQ(hdr.rfind("#?RADIANCE", 0), 0u);
   EXPECT_NE(hdr.find("-Y 32 +X 32"), std::string::npos);
 }

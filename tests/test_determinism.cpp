@@ -4,12 +4,9 @@
 #include "renderer/film/film.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
+#include "tests/support.h"
 
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <fcntl.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstring>
@@ -21,8 +18,6 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
-
 namespace pdflab {
 namespace {
 
@@ -30,62 +25,27 @@ namespace fs = std::filesystem;
 
 const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json";
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "pdflab-det-XXXXXX").string();
-    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::TempDir;
 
 // Renders the book scene at 24 x 20 (partial 16-pixel tiles on both axes) and
 // returns the PFM's bytes; stderr goes to a file in `dir` for diagnostics.
 std::string render_pfm(const TempDir& dir, const std::string& name, const std::string& threads,
                        const std::string& seed) {
   const std::string out = dir.file(name);
-  const std::string err = dir.file(name + ".stderr");
-  std::vector<std::string> storage = {PDFLAB_BINARY, "render",   "--scene", kBookScene, "--strategy",
-                                      "mix:cosine=0.5,light=0.5", "--spp",   "8",        "--width",
-                                      "24",          "--height", "20",      "--seed",   seed,
-                                      "--threads",   threads,    "--out",   out,        "--quiet"};
-  std::vector<char*> argv;
-  for (std::string& s : storage) argv.push_back(s.data());
-  argv.push_back(nullptr);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = 0;
-  const int rc = ::posix_spawn(&pid, PDFLAB_BINARY, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    ADD_FAILURE() << "posix_spawn failed: " << std::strerror(rc);
+  testing::ChildOptions o;
+  o.cwd = dir.path();
+  o.capture = dir.path();
+  o.deadline_seconds = 120.0;
+  const testing::ChildResult r =
+      testing::run_pdflab({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp", "8",
+                           "--width", "24", "--height", "20", "--seed", seed, "--threads", threads, "--out", out,
+                           "--quiet"},
+                          o);
+  if (!r.exited || r.status != 0) {
+    ADD_FAILURE() << "pdflab render failed (status " << r.status << "): " << r.err;
     return {};
   }
-  int status = 0;
-  if (::waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    ADD_FAILURE() << "pdflab render failed (status " << status << "): " << read_bytes(err);
-    return {};
-  }
-  std::string bytes = read_bytes(out);
+  std::string bytes = testing::slurp(out);
   EXPECT_GT(bytes.size(), 24u * 20u * 12u) << name;
   return bytes;
 }

@@ -9,7 +9,7 @@
 // test_cli.cpp covers the first example of each class (unknown flag, missing
 // scene, syntax error, ...); this table adds the long tail.
 #include "renderer/film/image_io.h"
-#include "tests/run_pdflab.h"
+#include "tests/support.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

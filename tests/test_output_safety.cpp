@@ -7,7 +7,7 @@
 // The full disk is a 64 KiB tmpfs when the test may mount one (root with
 // CAP_SYS_ADMIN, as in CI); otherwise the child gets a 64 KiB file size limit
 // (RLIMIT_FSIZE), whose EFBIG takes the same path through the writer as ENOSPC.
-#include "tests/run_pdflab.h"
+#include "tests/support.h"
 
 #include <gtest/gtest.h>
 #include <sys/mount.h>

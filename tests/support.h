@@ -1,24 +1,56 @@
 #pragma once
-// Runs the pdflab binary as a child process for the reliability tests: no
-// shell, stdin from /dev/null, stdout and stderr captured to files, a working
-// folder, a wall-clock deadline after which the child is killed, and an
-// optional file-size limit (RLIMIT_FSIZE) to simulate a full disk.
+// What the tests that touch files or run the binary share: a temporary folder
+// per test, and running the pdflab binary as a child process — no shell, stdin
+// from /dev/null, stdout and stderr captured to files, a working folder, a
+// wall-clock deadline after which the child is killed, and an optional
+// file-size limit (RLIMIT_FSIZE) to simulate a full disk.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <stdlib.h>
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 namespace pdflab::testing {
+
+// A fresh empty folder, removed with everything in it when the object goes.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix = "pdflab-test") {
+    std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "-XXXXXX")).string();
+    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  // Names directly inside the folder, sorted.
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(path_)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
 
 struct ChildResult {
   bool started = false;
