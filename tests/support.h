@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/time.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -58,6 +59,7 @@ struct ChildResult {
   bool timed_out = false;  // killed by the deadline
   int status = -1;         // exit status when exited
   double seconds = 0.0;    // wall time
+  double cpu_seconds = 0.0;  // user + system time of the child: what the load of the machine does not inflate
   std::string out, err;
 };
 
@@ -103,8 +105,9 @@ inline ChildResult run_pdflab(const std::vector<std::string>& args, const ChildO
   }
   r.started = true;
   int status = 0;
+  rusage usage{};
   for (;;) {
-    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
     if (done == pid) break;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (elapsed > o.deadline_seconds && !r.timed_out) {
@@ -114,6 +117,8 @@ inline ChildResult run_pdflab(const std::vector<std::string>& args, const ChildO
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.cpu_seconds = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                  static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
   r.exited = WIFEXITED(status) && !r.timed_out;
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = slurp(out_path);
