@@ -118,6 +118,25 @@ TEST(Extremes, NoDroppedSamplesWhenShadingPointsLieInTheLightsPlane) {
   }
 }
 
+TEST(Extremes, NextEventEstimationWithoutEmittersIsPlainCosineSampling) {
+  // A furnace: no emitter, only the sky. nee-mis has no light to sample, so it
+  // must behave exactly like cosine sampling (same random numbers aside).
+  const std::string text = R"({
+    "camera": {"width": 8, "height": 8, "vfov": 30, "lookfrom": [0, 0, -5], "lookat": [0, 0, 0],
+               "background": [1, 1, 1]},
+    "materials": {"white": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}]})";
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "furnace.json"));
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("nee-mis"), *scene);
+  EXPECT_TRUE(plan.emitters.empty());
+  EXPECT_TRUE(plan.emitters.sample(Vec3(0), 0.5f, 0.5f, 0.5f).none);
+  const Rendered r = render(scene, "nee-mis", 4);
+  EXPECT_EQ(r.stats.dropped.total(), 0u);
+  double m[3];
+  r.film.mean(static_cast<std::size_t>(4 * 8 + 4), m);  // the centre pixel sees the sphere
+  EXPECT_NEAR(m[0], 0.5, 1e-6);
+}
+
 // ---- Grazing angles ---------------------------------------------------------------
 
 TEST(Extremes, GrazingAnglesGiveFinitePositiveDensities) {

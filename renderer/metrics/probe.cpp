@@ -56,9 +56,10 @@ std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbeP
     if (plan.nee_mis) {
       // nee-mis draws two directions at a vertex: one from the emitters...
       const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-      const DirectionSample ls = plan.emitters.sample(at.point, uc, u1, u2);
-      if (!plan.emitters.empty())
+      if (!plan.emitters.empty()) {
+        const DirectionSample ls = plan.emitters.sample(at.point, uc, u1, u2);
         out.push_back({ls.direction, ls.pdf, ls.none ? -1 : static_cast<int>(Technique::LightSolidAngle)});
+      }
       // ...and one from the cosine lobe.
       const DirectionSample cs = sample_cosine_hemisphere(Onb(at.normal), rng.uniform(), rng.uniform());
       out.push_back({cs.direction, cs.pdf, static_cast<int>(Technique::Cosine)});

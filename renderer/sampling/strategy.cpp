@@ -174,6 +174,7 @@ float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const vo
 float TargetSet::pdf(const Vec3& origin, const Vec3& direction) const { return pdf_without(origin, direction, nullptr); }
 
 DirectionSample TargetSet::sample(const Vec3& origin, float u_choice, float u1, float u2) const {
+  if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at
   int chosen = 0;
   const int n = size();
   while (chosen < n - 1 && u_choice >= cdf[chosen]) ++chosen;
