@@ -202,7 +202,8 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
   ui::draw_probe_panel(probe_, now, area_width, area_height);
   if (was_open && !probe_.open) probe_.mode = false;  // its close button ends probing
   if (probe_.mode) {
-    ImGui::SetNextWindowPos(ImVec2(area_width * 0.5f, 8.0f), ImGuiCond_Always, ImVec2(0.5f, 0.0f));
+    // Bottom-left: the probe panel opens at the top right.
+    ImGui::SetNextWindowPos(ImVec2(8.0f, area_height - 8.0f), ImGuiCond_Always, ImVec2(0.0f, 1.0f));
     ImGui::SetNextWindowBgAlpha(0.6f);
     const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoInputs |

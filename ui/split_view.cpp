@@ -116,10 +116,10 @@ void draw_split_controls(SplitState& s, SplitRequests& requests, float area_widt
     ImGui::End();
     return;
   }
-  ImGui::TextColored(kDim, "Split A/B (S): same scene and seed, %d thread%s a side, equal time", s.threads_per_side,
+  ImGui::TextColored(kDim, "Split A/B (S): same seed, equal time");
+  ImGui::TextColored(kDim, "A: side panel strategy, %d thread%s a side", s.threads_per_side,
                      s.threads_per_side == 1 ? "" : "s");
-  ImGui::TextColored(kDim, "A: the side panel's strategy; drag the divider to compare");
-  const float field = ImGui::GetFontSize() * 14.0f;
+  const float field = ImGui::GetFontSize() * 12.0f;
   ImGui::SetNextItemWidth(field);
   if (ImGui::BeginCombo("B strategy", s.b_strategy.c_str())) {
     for (const std::string& choice : split_strategy_choices())
