@@ -1,6 +1,7 @@
 #include "app/viewer.h"
 
 #include "app/assets.h"
+#include "app/teaching.h"
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
@@ -83,6 +84,7 @@ struct Viewer::Impl {
   bool imgui_ready = false;
   std::unique_ptr<ui::ImageDisplay> display;
   std::unique_ptr<RenderSession> session;
+  std::unique_ptr<TeachingViews> teaching;
 
   std::shared_ptr<const Scene> base_scene;  // as loaded
   std::string scene_path;
@@ -171,6 +173,7 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   // A new image ends the wait between frames at once instead of at the next tick.
   so.on_image = [] { glfwPostEmptyEvent(); };
   session = std::make_unique<RenderSession>(so);
+  teaching = std::make_unique<TeachingViews>(so.on_image);
   if (!apply_render_settings()) throw InputError(status.settings_error);
 }
 
@@ -286,6 +289,7 @@ void Viewer::Impl::rebuild_fonts() {
 }
 
 void Viewer::Impl::close() {
+  teaching.reset();
   session.reset();  // workers stop first: nothing renders into a closing viewer
   if (save_job.valid()) save_job.wait();
   display.reset();
@@ -370,6 +374,7 @@ void Viewer::Impl::load_scene(const std::string& path) {
 void Viewer::Impl::on_key(int key) {
   // Typing a path must not pause the render or restart it.
   if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12 && key != GLFW_KEY_ESCAPE) return;
+  if (teaching->on_key(key, *session, settings.paused)) return;
   switch (key) {
     case GLFW_KEY_SPACE:
       settings.paused = !settings.paused;
@@ -502,6 +507,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   for (int key : v.keys) v.on_key(key);
   v.keys.clear();
   v.pull_image();
+  v.teaching->update(*v.session, v.settings.paused);
   v.service_screenshots();
 
   int fb_w = 0, fb_h = 0;
@@ -518,7 +524,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
     v.settle_frames = 3;
   }
   // Elapsed time and samples/s tick between images: a few redraws a second show that.
-  const bool draw = force_draw || v.texture_stale || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
+  const bool draw = force_draw || v.texture_stale || v.teaching->wants_frames() || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
                     t0 - v.last_draw > std::chrono::milliseconds(250);
   if (!draw) {
     if (paced) glfwWaitEventsTimeout(kFramePeriod);
@@ -543,6 +549,12 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
   ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
   ui::draw_image_badges(v.settings, v.status);
+  {
+    const int image_px = static_cast<int>(panel_width * v.framebuffer_scale);
+    const ui::Viewport image_area{0, 0, std::max(0, fb_w - image_px), fb_h};
+    v.teaching->draw_ui(*v.session, ui::fit_image(image_area, v.image_info.width, v.image_info.height), fb_h,
+                        v.framebuffer_scale, io.DisplaySize.x - panel_width, io.DisplaySize.y);
+  }
   ImGui::Render();
 
   if (!requests.load_scene.empty()) v.load_scene(requests.load_scene);
@@ -569,8 +581,12 @@ bool Viewer::frame(bool paced, bool force_draw) {
   glClear(GL_COLOR_BUFFER_BIT);
   glDisable(GL_SCISSOR_TEST);
   const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
-  v.display->draw(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
-                  v.settings.srgb);
+  if (v.teaching->split_active())
+    v.teaching->draw_split_image(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
+                                 v.settings.srgb);
+  else
+    v.display->draw(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
+                    v.settings.srgb);
   glViewport(0, 0, fb_w, fb_h);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   glfwSwapBuffers(v.window);
@@ -587,7 +603,8 @@ bool Viewer::frame(bool paced, bool force_draw) {
     // Events wake the wait early, so input is never delayed by the pacing.
     const SessionStats& st = v.status.stats;
     const bool busy = !(st.done || st.paused) || v.save_job.valid() || v.screenshot_wanted ||
-                      ImGui::IsAnyItemActive() || v.status.now - v.status.notice.shown_at < 0.5;
+                      ImGui::IsAnyItemActive() || v.status.now - v.status.notice.shown_at < 0.5 ||
+                      v.teaching->wants_frames();
     const double period = busy ? kFramePeriod : kIdlePeriod;
     const double spent = std::chrono::duration<double>(Clock::now() - t0).count();
     if (spent < period) glfwWaitEventsTimeout(period - spent);

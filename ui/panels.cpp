@@ -284,6 +284,9 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"2", "preset: light only"},
         {"3", "preset: book 50/50 (cosine + light)"},
         {"F12", "screenshot: PNG + PFM + JSON"},
+        {"S", "split screen A/B: two strategies, equal time"},
+        {"P", "pixel probe: click a pixel (C: chi-square)"},
+        {"L", "1D lab: f, p, inverse CDF, pi"},
         {"H, F1", "this help"},
         {"Esc", "quit"},
     };

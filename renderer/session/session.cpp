@@ -1,5 +1,7 @@
 #include "renderer/session/session.h"
 
+#include "renderer/metrics/metrics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -182,6 +184,10 @@ void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
   info.preview_scale = pass.preview ? pass.preview_scale : 1;
   info.data_width = pass.preview ? pass.width : info.width;
   info.data_height = pass.preview ? pass.height : info.height;
+  if (options_.publish_noise && !pass.preview) {
+    info.noise = mean_relative_standard_error(film_);
+    info.estimated_relmse = estimated_relmse(film_);
+  }
   // The UI thread only ever takes image_mutex_, never mutex_.
   {
     std::lock_guard ik(image_mutex_);

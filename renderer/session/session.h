@@ -52,6 +52,10 @@ struct ImageInfo {
   std::uint32_t spp = 0;         // samples per pixel in the image (0 for a preview)
   double seconds = 0.0;          // rendering time of the generation when published
   bool preview = false;          // low-resolution first look, not part of the film
+  // With SessionOptions::publish_noise, the film's own noise figures at this
+  // pass (metrics.h); -1 otherwise and for previews.
+  double noise = -1.0;             // mean_relative_standard_error
+  double estimated_relmse = -1.0;  // estimated_relmse
 };
 
 struct SessionOptions {
@@ -66,6 +70,10 @@ struct SessionOptions {
   // Called by a worker right after each new image is published (a viewer wakes
   // its event loop with it). Must be cheap and safe to call from any thread.
   std::function<void()> on_image;
+  // Fill ImageInfo::noise and estimated_relmse at every full pass. The film is
+  // consistent only between passes, so they are measured there, under the lock
+  // (a pass over the pixels: about a millisecond for 600x600).
+  bool publish_noise = false;
 };
 
 class RenderSession {

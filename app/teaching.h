@@ -1,0 +1,66 @@
+#pragma once
+// The teaching views in the viewer: split screen A/B, the pixel probe and the
+// 1D lab. The viewer calls these few hooks; everything else about the views
+// lives here and in ui/split_view, ui/probe_panel, ui/lab1d_panel.
+#include "renderer/session/session.h"
+#include "ui/display.h"
+#include "ui/lab1d_panel.h"
+#include "ui/probe_panel.h"
+#include "ui/split_view.h"
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace pdflab {
+
+class TeachingViews {
+ public:
+  // on_image: wakes the viewer's event loop (called from render threads).
+  explicit TeachingViews(std::function<void()> on_image);
+  ~TeachingViews();
+  TeachingViews(const TeachingViews&) = delete;
+  TeachingViews& operator=(const TeachingViews&) = delete;
+
+  // S split, P probe mode, L 1D lab, C chi-square at the probed point.
+  bool on_key(int glfw_key, RenderSession& main, bool paused);
+  // Before drawing: keeps the split sessions in step with the main session
+  // (which rests while the split renders) and collects their images.
+  void update(RenderSession& main, bool paused);
+  // Inside the ImGui frame. `image` is where the viewer shows the image
+  // (framebuffer pixels, origin bottom-left), `area_*` the image area in ImGui units.
+  void draw_ui(RenderSession& main, const ui::Viewport& image, int framebuffer_height, float framebuffer_scale,
+               float area_width, float area_height);
+  bool split_active() const { return split_.on; }
+  // OpenGL: both halves into `where`, A left of the divider.
+  void draw_split_image(const ui::Viewport& where, float exposure_ev, bool srgb);
+  // Something changes on screen without input: a split image, the lab, a running check.
+  bool wants_frames() const;
+
+ private:
+  void enter_split(RenderSession& main);
+  void leave_split(RenderSession& main, bool paused);
+  void restart_split(const RenderSettings& main_settings);
+  void load_reference();
+  void pull(RenderSession& session, std::vector<float>& image, ImageInfo& info, std::uint64_t& version, bool& stale,
+            ui::SideFigures& figures);
+
+  std::function<void()> on_image_;
+  ui::SplitState split_;
+  ui::ProbeState probe_;
+  ui::Lab1dState lab_;
+  bool lab_open_ = false;
+
+  std::unique_ptr<RenderSession> a_, b_;
+  std::uint64_t seen_main_generation_ = ~std::uint64_t{0};
+  std::string b_running_;  // B's strategy as rendering now
+  std::vector<float> image_a_, image_b_;
+  ImageInfo info_a_, info_b_;
+  std::uint64_t version_a_ = 0, version_b_ = 0;
+  bool stale_a_ = false, stale_b_ = false, new_image_ = false;
+  std::unique_ptr<ui::ImageDisplay> display_a_, display_b_;
+  std::vector<float> reference_;
+  int reference_width_ = 0, reference_height_ = 0;
+};
+
+}  // namespace pdflab

@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# GUI test of the teaching views under Xvfb, driven with xdotool: split screen
+# (S, then dragging the divider), pixel probe (P, a click, C for chi-square)
+# and the 1D lab (L). Each view is captured; each capture must be non-blank
+# and differ from the one before it.
+#   gui_teaching.sh PDFLAB SCENE ARTIFACT_DIR [DOCS_DIR]
+# With DOCS_DIR the views are rendered longer and saved there as
+# view_split.png, view_probe.png, view_lab1d.png.
+# Exit 77 only when xvfb-run itself is missing.
+set -euo pipefail
+
+if [ "${1:-}" != "--inside" ]; then
+  if ! command -v xvfb-run >/dev/null 2>&1; then
+    echo "SKIP: xvfb-run is not installed (Debian: apt-get install xvfb xauth)"
+    exit 77
+  fi
+  for tool in xdotool import identify compare; do
+    command -v "$tool" >/dev/null 2>&1 || { echo "FAIL: $tool is missing (xdotool, imagemagick)"; exit 1; }
+  done
+  exec xvfb-run -a -s "-screen 0 1400x900x24" bash "$0" --inside "$@"
+fi
+shift
+pdflab=$1 scene=$2 art=$3 docs=${4:-}
+rm -rf "$art"
+mkdir -p "$art"
+fail() { echo "FAIL: $*"; exit 1; }
+settle=2
+[ -n "$docs" ] && settle=12
+
+# not_blank FILE: some brightness and some structure.
+not_blank() {
+  read -r mean sd <<<"$(identify -format "%[fx:mean] %[fx:standard_deviation]" "$1")"
+  echo "$(basename "$1"): mean=$mean sd=$sd"
+  awk -v m="$mean" -v s="$sd" 'BEGIN { exit !(m > 0.02 && s > 0.02) }' || fail "$1 looks blank"
+}
+# changed A B: root-mean-square difference (0..1) above a small floor.
+changed() {
+  local d
+  # compare exits 1 when the images differ: that is the expected case here.
+  d=$( (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p')
+  echo "$(basename "$1") -> $(basename "$2"): RMSE $d"
+  awk -v d="$d" 'BEGIN { exit !(d > 0.01) }' || fail "$2 did not change from $1"
+}
+shot() { import -window "$wid" "$art/$1.png"; }
+
+"$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" &
+viewer=$!
+trap 'kill $viewer 2>/dev/null || true' EXIT
+wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+[ -n "$wid" ] || fail "no viewer window"
+xdotool windowfocus --sync "$wid"
+xdotool mousemove 2 2
+sleep 2
+eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
+shot base
+not_blank "$art/base.png"
+
+# The image area is left of the 400-pixel side panel; the (square) image is
+# centred in it.
+area_w=$((WIDTH - 400))
+cx=$((area_w / 2)) cy=$((HEIGHT / 2))
+size=$((area_w < HEIGHT ? area_w : HEIGHT))
+left=$(((area_w - size) / 2)) top=$(((HEIGHT - size) / 2))
+
+echo "== split screen"
+xdotool key --window "$wid" s
+sleep "$settle"
+shot split
+not_blank "$art/split.png"
+changed "$art/base.png" "$art/split.png"
+# Drag the divider from the middle towards the left.
+xdotool mousemove "$cx" "$cy" mousedown 1
+for dx in 20 40 60 80 100; do xdotool mousemove "$((cx - dx))" "$cy"; sleep 0.1; done
+xdotool mouseup 1
+xdotool mousemove 2 2
+sleep 1
+shot split_dragged
+changed "$art/split.png" "$art/split_dragged.png"
+[ -n "$docs" ] && cp "$art/split_dragged.png" "$docs/view_split.png"
+xdotool key --window "$wid" s
+sleep 1
+
+echo "== pixel probe"
+xdotool key --window "$wid" p
+sleep 0.5
+# A pixel of the floor, left of the image's centre, low down.
+xdotool mousemove "$((left + size * 30 / 100))" "$((top + size * 88 / 100))" click 1
+xdotool mousemove 2 2
+sleep 1
+shot probe
+not_blank "$art/probe.png"
+changed "$art/split_dragged.png" "$art/probe.png"
+xdotool key --window "$wid" c
+sleep 0.3
+# The check runs in the background (a fraction of a second here) while the
+# window keeps drawing.
+sleep 3
+shot probe_chi
+changed "$art/probe.png" "$art/probe_chi.png"
+[ -n "$docs" ] && cp "$art/probe_chi.png" "$docs/view_probe.png"
+xdotool key --window "$wid" p
+sleep 0.5
+
+echo "== 1D lab"
+xdotool key --window "$wid" l
+sleep "$settle"
+shot lab
+not_blank "$art/lab.png"
+changed "$art/probe_chi.png" "$art/lab.png"
+sleep 1
+shot lab_later
+# The running estimate keeps drawing samples: the plots move.
+changed "$art/lab.png" "$art/lab_later.png"
+[ -n "$docs" ] && cp "$art/lab_later.png" "$docs/view_lab1d.png"
+
+xdotool key --window "$wid" Escape
+wait $viewer || fail "viewer exited with status $?"
+trap - EXIT
+echo "PASS"

@@ -1,0 +1,261 @@
+#include "ui/lab1d_panel.h"
+
+#include "renderer/sampling/rng.h"
+#include "ui/teach_draw.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace pdflab::ui {
+
+namespace {
+
+const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
+const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
+const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
+constexpr ImU32 kF = IM_COL32(90, 170, 255, 255);
+constexpr ImU32 kP = IM_COL32(255, 190, 60, 255);
+constexpr ImU32 kHist = IM_COL32(255, 190, 60, 110);
+constexpr ImU32 kExact = IM_COL32(120, 220, 120, 255);
+constexpr ImU32 kPlain = IM_COL32(255, 100, 80, 255);
+constexpr ImU32 kStrat = IM_COL32(90, 170, 255, 255);
+
+// 53 random bits: with 24, u = 0 would come up once in 16 million samples,
+// and the pdfs that vanish at 0 make that sample special.
+double unit_double(Rng& rng) {
+  const std::uint64_t hi = rng.next_u32(), lo = rng.next_u32();
+  return static_cast<double>(((hi << 32) | lo) >> 11) * 0x1.0p-53;
+}
+
+std::vector<double> linspace(double a, double b, int n) {
+  std::vector<double> v(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = a + (b - a) * i / (n - 1);
+  return v;
+}
+
+}  // namespace
+
+int lab_bin(double x, int bins) {
+  if (!(x >= lab::kLow) || !(x < lab::kHigh) || bins <= 0) return -1;
+  return std::min(bins - 1, static_cast<int>((x - lab::kLow) / (lab::kHigh - lab::kLow) * bins));
+}
+
+PiStudy run_pi_study(int max_power_of_four, int seeds) {
+  PiStudy study;
+  for (int k = 1; k <= max_power_of_four; ++k) {
+    const std::uint64_t n = std::uint64_t{1} << (2 * k);
+    double plain = 0.0, strat = 0.0;
+    for (int s = 1; s <= seeds; ++s) {
+      const double a = lab::estimate_pi(n, static_cast<std::uint64_t>(s)) - std::numbers::pi;
+      const double b = lab::estimate_pi_stratified(n, static_cast<std::uint64_t>(s)) - std::numbers::pi;
+      plain += a * a;
+      strat += b * b;
+    }
+    study.n.push_back(static_cast<double>(n));
+    study.plain_error.push_back(std::sqrt(plain / seeds));
+    study.stratified_error.push_back(std::sqrt(strat / seeds));
+  }
+  return study;
+}
+
+void Lab1dState::select(lab::Integrand f, lab::Pdf p) {
+  integrand = f;
+  pdf = p;
+  reset();
+}
+
+void Lab1dState::reset() {
+  estimator = lab::Estimator(integrand, pdf);
+  std::fill(histogram.begin(), histogram.end(), 0);
+  history.clear();
+  next_record_ = 1;
+  stream_ = 0;
+}
+
+void Lab1dState::step(int count) {
+  // Each call draws from its own stream, keyed by (seed, call index): a run is
+  // reproducible from the seed and the calls made, whatever the frame rate.
+  Rng rng(mix64(seed) ^ stream_, 0x5eed);
+  for (int i = 0; i < count && estimator.count() < max_samples; ++i) {
+    const double u = unit_double(rng);
+    const double x = lab::inverse_cdf(pdf, u);
+    estimator.add(u);
+    const int b = lab_bin(x, static_cast<int>(histogram.size()));
+    if (b >= 0) ++histogram[static_cast<std::size_t>(b)];
+    if (estimator.count() >= next_record_) {
+      history.push_back({estimator.count(), estimator.mean(), estimator.standard_error()});
+      // About 25 points per decade: even spacing on the log axis.
+      next_record_ = std::max(next_record_ + 1, static_cast<std::uint64_t>(static_cast<double>(next_record_) * 1.1));
+    }
+  }
+  ++stream_;
+}
+
+namespace {
+
+void curves_plot(const Lab1dState& s, ImVec2 size) {
+  const std::vector<double> xs = linspace(lab::kLow, lab::kHigh, 241);
+  std::vector<double> fs, ps;
+  for (double x : xs) {
+    fs.push_back(lab::integrand(s.integrand, x));
+    ps.push_back(lab::pdf(s.pdf, x));
+  }
+  std::vector<double> all = fs;
+  all.insert(all.end(), ps.begin(), ps.end());
+  all.push_back(0.0);
+  const draw::Plot plot("f(x) and p(x)", size, {lab::kLow, lab::kHigh}, draw::fit_axis(all, false), "x");
+  plot.line(xs, fs, kF, 2.0f);
+  plot.line(xs, ps, kP, 2.0f);
+  plot.legend({{"f(x) = " + std::string(lab::integrand_name(s.integrand)), kF},
+               {"p(x) " + std::string(lab::pdf_name(s.pdf)), kP}},
+              true);
+}
+
+void histogram_plot(const Lab1dState& s, ImVec2 size) {
+  const int bins = static_cast<int>(s.histogram.size());
+  const double width = (lab::kHigh - lab::kLow) / bins;
+  std::vector<double> density(s.histogram.size(), 0.0);
+  const double n = static_cast<double>(std::max<std::uint64_t>(1, s.count()));
+  for (std::size_t i = 0; i < density.size(); ++i) density[i] = static_cast<double>(s.histogram[i]) / (n * width);
+  const std::vector<double> xs = linspace(lab::kLow, lab::kHigh, 241);
+  std::vector<double> ps;
+  for (double x : xs) ps.push_back(lab::pdf(s.pdf, x));
+  std::vector<double> all = density;
+  all.insert(all.end(), ps.begin(), ps.end());
+  all.push_back(0.0);
+  const std::string title = "samples by inverse CDF (" + std::to_string(s.count()) + ") vs p(x)";
+  const draw::Plot plot(title.c_str(), size, {lab::kLow, lab::kHigh}, draw::fit_axis(all, false), "x");
+  plot.bars(lab::kLow, width, density, kHist);
+  plot.line(xs, ps, kP, 2.0f);
+  plot.legend({{"histogram / (N dx)", kHist}, {"p(x)", kP}}, true);
+}
+
+void estimate_plot(const Lab1dState& s, ImVec2 size) {
+  std::vector<double> ns, mean, lo, hi;
+  for (const LabHistoryPoint& h : s.history) {
+    ns.push_back(static_cast<double>(h.n));
+    mean.push_back(h.mean);
+    lo.push_back(h.mean - h.standard_error);
+    hi.push_back(h.mean + h.standard_error);
+  }
+  const double exact = lab::exact_integral(s.integrand);
+  std::vector<double> all = mean;
+  all.push_back(exact);
+  // The first few estimates can be wild; keep the exact value in clear view.
+  for (std::size_t i = 0; i < lo.size(); ++i)
+    if (ns[i] >= 16.0) all.insert(all.end(), {lo[i], hi[i]});
+  draw::Axis y = draw::fit_axis(all, false, 0.1);
+  const double span = std::max(y.hi - y.lo, std::abs(exact) * 0.05);
+  y = {std::min(y.lo, exact - span * 0.5), std::max(y.hi, exact + span * 0.5), false};
+  const draw::Axis x{1.0, std::max(10.0, ns.empty() ? 10.0 : ns.back()), true};
+  const draw::Plot plot("running estimate +- standard error", size, x, y, "N (log)");
+  plot.band(ns, lo, hi, IM_COL32(90, 170, 255, 70));
+  plot.hline(exact, kExact);
+  plot.line(ns, mean, kF, 2.0f);
+  plot.legend({{"estimate", kF}, {"+- 1 std. error", IM_COL32(90, 170, 255, 120)}, {"exact", kExact}});
+}
+
+void pi_plot(Lab1dState& s, ImVec2 size) {
+  if (s.pi.n.empty()) {
+    if (!s.pi_job.valid()) s.pi_job = std::async(std::launch::async, [] { return run_pi_study(); });
+    if (s.pi_job.wait_for(std::chrono::seconds(0)) == std::future_status::ready) s.pi = s.pi_job.get();
+  }
+  if (s.pi.n.empty()) {
+    ImGui::TextColored(kDim, "estimating pi... (running)");
+    ImGui::Dummy(ImVec2(size.x, size.y - ImGui::GetTextLineHeightWithSpacing()));
+    return;
+  }
+  const PiStudy& p = s.pi;
+  // Reference slopes through the first plain point: N^-1/2 (plain), N^-3/4
+  // (jittered points on a smooth boundary in 2D).
+  std::vector<double> half, three_quarter;
+  for (double n : p.n) {
+    half.push_back(p.plain_error.front() * std::sqrt(p.n.front() / n));
+    three_quarter.push_back(p.stratified_error.front() * std::pow(p.n.front() / n, 0.75));
+  }
+  std::vector<double> all = p.plain_error;
+  all.insert(all.end(), p.stratified_error.begin(), p.stratified_error.end());
+  const draw::Plot plot("pi: RMS error vs N (8 seeds)", size, {p.n.front() * 0.7, p.n.back() * 1.4, true},
+                        draw::fit_axis(all, true), "N (log)");
+  plot.line(p.n, half, IM_COL32(255, 100, 80, 110), 1.0f);
+  plot.line(p.n, three_quarter, IM_COL32(90, 170, 255, 110), 1.0f);
+  plot.line(p.n, p.plain_error, kPlain, 2.0f);
+  plot.line(p.n, p.stratified_error, kStrat, 2.0f);
+  plot.legend({{"uniform points  ~N^-1/2", kPlain}, {"stratified (jittered)  ~N^-3/4", kStrat}});
+}
+
+}  // namespace
+
+void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_height) {
+  // The lab is about no image: it may cover the side panel too.
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float w = std::min(std::max(area_width, display.x) - 20.0f, 960.0f);
+  const float h = std::min(std::max(area_height, display.y) - 20.0f, 740.0f);
+  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_Appearing);
+  ImGui::SetNextWindowSize(ImVec2(std::max(w, 300.0f), std::max(h, 300.0f)), ImGuiCond_Appearing);
+  ImGui::SetNextWindowBgAlpha(0.97f);
+  if (!ImGui::Begin("1D lab: Monte Carlo on [0, 2] (L)", open, ImGuiWindowFlags_NoSavedSettings)) {
+    ImGui::End();
+    return;
+  }
+  if (s.running) s.step(s.samples_per_frame);
+
+  lab::Integrand f = s.integrand;
+  lab::Pdf p = s.pdf;
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8.0f);
+  if (ImGui::BeginCombo("f(x)", std::string(lab::integrand_name(f)).c_str())) {
+    for (int i = 0; i < static_cast<int>(lab::Integrand::Count); ++i) {
+      const auto v = static_cast<lab::Integrand>(i);
+      if (ImGui::Selectable(std::string(lab::integrand_name(v)).c_str(), v == f)) f = v;
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8.0f);
+  if (ImGui::BeginCombo("p(x)", std::string(lab::pdf_name(p)).c_str())) {
+    for (int i = 0; i < static_cast<int>(lab::Pdf::Count); ++i) {
+      const auto v = static_cast<lab::Pdf>(i);
+      if (ImGui::Selectable(std::string(lab::pdf_name(v)).c_str(), v == p)) p = v;
+    }
+    ImGui::EndCombo();
+  }
+  if (f != s.integrand || p != s.pdf) s.select(f, p);
+  ImGui::SameLine();
+  if (ImGui::Button(s.running ? "Pause" : "Run")) s.running = !s.running;
+  ImGui::SameLine();
+  if (ImGui::Button("Reset")) s.reset();
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
+  ImGui::SliderInt("samples/frame", &s.samples_per_frame, 1, 4096, "%d", ImGuiSliderFlags_Logarithmic);
+
+  const double exact = lab::exact_integral(s.integrand);
+  ImGui::Text("N = %llu   estimate %.5f +- %.5f   exact %.5f   error %+.2e", static_cast<unsigned long long>(s.count()),
+              s.estimator.mean(), s.estimator.standard_error(), exact, s.estimator.mean() - exact);
+  if (!lab::has_finite_variance(s.integrand, s.pdf)) {
+    ImGui::TextColored(kRed,
+                       "Infinite variance: p(x) falls to zero faster than f(x) somewhere. Still unbiased, but the\n"
+                       "standard error is not to be trusted and the error does not fall like 1/sqrt(N).");
+  } else if (s.count() > 1 && s.estimator.standard_error() < 1e-6 * std::abs(s.estimator.mean())) {
+    // (Not exactly zero: E[x^2] - E[x]^2 keeps a rounding residue.)
+    ImGui::TextColored(kGreen, "Zero variance: p(x) is proportional to f(x), every sample gives the exact value.");
+  } else {
+    ImGui::TextColored(kDim, "Finite variance: the standard error falls like 1/sqrt(N).");
+  }
+
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const float gap = ImGui::GetStyle().ItemSpacing.x;
+  const ImVec2 cell((avail.x - gap) * 0.5f, std::max(140.0f, (avail.y - ImGui::GetStyle().ItemSpacing.y) * 0.5f));
+  curves_plot(s, cell);
+  ImGui::SameLine();
+  histogram_plot(s, cell);
+  estimate_plot(s, cell);
+  ImGui::SameLine();
+  pi_plot(s, cell);
+  ImGui::End();
+}
+
+}  // namespace pdflab::ui

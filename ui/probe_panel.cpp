@@ -1,0 +1,319 @@
+#include "ui/probe_panel.h"
+
+#include "renderer/error.h"
+#include "ui/teach_draw.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace pdflab::ui {
+
+namespace {
+
+const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
+const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
+const ImVec4 kAmber{1.0f, 0.78f, 0.3f, 1.0f};
+const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
+
+constexpr int kProbeDirections = 400;
+constexpr int kMapWidth = 96, kMapHeight = 48;
+constexpr int kLobeWidth = 64, kLobeHeight = 32;
+constexpr int kChiSamples = 200000;
+
+ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h) {
+  ProbeMap map;
+  map.title = title;
+  try {
+    const SamplingPlan plan = SamplingPlan::make(strategy, scene);
+    map.values = pdf_map(plan, at, w, h);
+    map.width = w;
+    map.height = h;
+    for (float v : map.values)
+      if (std::isfinite(v)) map.max_value = std::max(map.max_value, v);
+  } catch (const InputError& e) {
+    map.error = e.what();
+  }
+  return map;
+}
+
+// The map as coloured cells. Log scale: four decades below the maximum, so a
+// mixture's broad cosine part shows beside its sharp light part.
+void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale) {
+  ImGui::TextUnformatted(map.title.c_str());
+  const ImVec2 p0 = ImGui::GetCursorScreenPos();
+  ImGui::Dummy(size);
+  ImDrawList* list = ImGui::GetWindowDrawList();
+  if (!map.error.empty() || map.width == 0) {
+    list->AddRectFilled(p0, ImVec2(p0.x + size.x, p0.y + size.y), IM_COL32(30, 30, 36, 255));
+    list->AddText(ImGui::GetFont(), ImGui::GetFontSize(), ImVec2(p0.x + 6, p0.y + 6), IM_COL32(255, 110, 100, 255),
+                  map.error.empty() ? "no surface" : map.error.c_str(), nullptr, size.x - 12.0f);
+    return;
+  }
+  const float cw = size.x / static_cast<float>(map.width), ch = size.y / static_cast<float>(map.height);
+  const double top = map.max_value > 0.0f ? map.max_value : 1.0;
+  for (int r = 0; r < map.height; ++r)
+    for (int c = 0; c < map.width; ++c) {
+      const double v = map.values[static_cast<std::size_t>(r) * map.width + c];
+      const double t = log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top;
+      const float x = p0.x + cw * static_cast<float>(c), y = p0.y + ch * static_cast<float>(r);
+      list->AddRectFilled(ImVec2(x, y), ImVec2(x + cw + 0.5f, y + ch + 0.5f), draw::colormap(static_cast<float>(t)));
+    }
+  // The horizon: above it the hemisphere of the surface, below it the directions into it.
+  const float hy = p0.y + size.y * 0.5f;
+  list->AddLine(ImVec2(p0.x, hy), ImVec2(p0.x + size.x, hy), IM_COL32(255, 255, 255, 120));
+  list->AddRect(p0, ImVec2(p0.x + size.x, p0.y + size.y), IM_COL32(110, 110, 120, 255));
+}
+
+void draw_disc(ImDrawList* list, ImVec2 centre, float radius, const char* label) {
+  list->AddCircleFilled(centre, radius, IM_COL32(24, 24, 30, 255), 64);
+  for (float f : {0.5f, std::sqrt(0.5f)})  // cos theta = 0.75 and 0.5 (equal-area radii)
+    list->AddCircle(centre, radius * f, IM_COL32(70, 70, 80, 255), 48);
+  list->AddCircle(centre, radius, IM_COL32(130, 130, 140, 255), 64, 1.5f);
+  list->AddLine(ImVec2(centre.x - radius, centre.y), ImVec2(centre.x + radius, centre.y), IM_COL32(55, 55, 65, 255));
+  list->AddLine(ImVec2(centre.x, centre.y - radius), ImVec2(centre.x, centre.y + radius), IM_COL32(55, 55, 65, 255));
+  const float w = ImGui::CalcTextSize(label).x;
+  list->AddText(ImVec2(centre.x - w * 0.5f, centre.y + radius + 3.0f), IM_COL32(175, 175, 185, 255), label);
+}
+
+void directions_view(const ProbeState& s, float radius) {
+  const float line = ImGui::GetTextLineHeight();
+  const ImVec2 p0 = ImGui::GetCursorScreenPos();
+  ImGui::Dummy(ImVec2(radius * 3.5f + 30.0f, radius * 2.0f + line + 8.0f));
+  ImDrawList* list = ImGui::GetWindowDrawList();
+  const ImVec2 upper(p0.x + radius + 2.0f, p0.y + radius + 2.0f);
+  const ImVec2 lower(upper.x + radius * 2.0f + 24.0f, upper.y);
+  draw_disc(list, upper, radius, "above (normal at centre)");
+  draw_disc(list, lower, radius * 0.75f, "below the surface");
+  for (const ProbeSample& sample : s.samples) {
+    if (sample.technique < 0) continue;
+    float u = 0.0f, v = 0.0f;
+    direction_to_map(s.point, sample.direction, u, v);
+    const DiscPoint d = project_to_disc(u, v);
+    const ImVec2 c = d.lower ? lower : upper;
+    const float r = d.lower ? radius * 0.75f : radius;
+    list->AddCircleFilled(ImVec2(c.x + d.x * r, c.y - d.y * r), 2.2f, draw::technique_colour(sample.technique), 8);
+  }
+}
+
+void legend(const ProbeState& s) {
+  for (int t = 0; t <= kTechniqueCount; ++t) {
+    const int count = s.technique_counts[static_cast<std::size_t>(t)];
+    if (count == 0) continue;
+    const bool none = t == kTechniqueCount;
+    const ImU32 col = draw::technique_colour(none ? -1 : t);
+    const ImVec2 p = ImGui::GetCursorScreenPos();
+    const float line = ImGui::GetTextLineHeight();
+    ImGui::GetWindowDrawList()->AddCircleFilled(ImVec2(p.x + line * 0.4f, p.y + line * 0.5f), line * 0.3f, col, 12);
+    ImGui::Dummy(ImVec2(line, line));
+    ImGui::SameLine();
+    ImGui::Text("%s  %d", none ? "no direction" : std::string(technique_name(static_cast<Technique>(t))).c_str(),
+                count);
+  }
+}
+
+void chi_square_section(ProbeState& s, double now) {
+  if (s.plan && s.plan->nee_mis) {
+    ImGui::TextColored(kDim, "nee-mis takes two directions per vertex, not one\nsample/pdf pair: "
+                             "check its two techniques alone.");
+    return;
+  }
+  ImGui::BeginDisabled(s.chi_running());
+  if (ImGui::Button(s.chi_running() ? "running..." : "Chi-square check (C)")) start_probe_chi_square(s, now);
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (s.chi_running()) {
+    ImGui::TextColored(kAmber, "running... %.1f s", now - s.chi_started);
+    return;
+  }
+  if (!s.chi) {
+    ImGui::TextColored(kDim, "%d samples vs the pdf integrated per cell", kChiSamples);
+    return;
+  }
+  const ProbeChiSquare& c = *s.chi;
+  ImGui::TextColored(c.passed ? kGreen : kRed, "%s", c.passed ? "PASS" : "FAIL");
+  ImGui::SameLine();
+  ImGui::Text("p = %.3g  (alpha %.2g)   chi2 %.1f, dof %d   %.2f s", c.result.p_value, c.alpha, c.result.statistic,
+              c.result.dof, s.chi_seconds);
+  if (c.result.zero_cell_hits > 0)
+    ImGui::TextColored(kRed, "%llu samples where the pdf is zero",
+                       static_cast<unsigned long long>(c.result.zero_cell_hits));
+  const BandHistogram bands = cos_theta_bands(c);
+  const int n = static_cast<int>(bands.observed.size());
+  std::vector<double> all = bands.observed;
+  all.insert(all.end(), bands.expected.begin(), bands.expected.end());
+  all.push_back(0.0);
+  const float width = ImGui::GetContentRegionAvail().x;
+  const draw::Plot plot("samples per cos(theta) band vs the pdf integrated over the band",
+                        ImVec2(width, 150.0f), {1.0, -1.0}, draw::fit_axis(all, false),
+                        "cos(theta): +1 along the normal ... -1 straight into the surface");
+  // Bars from cos = +1 at the left, bands of equal width 2 / n in cos(theta).
+  plot.bars(1.0, -2.0 / n, bands.observed, IM_COL32(90, 170, 255, 200));
+  std::vector<double> xs, ys;
+  for (int i = 0; i < n; ++i) {
+    const double a = 1.0 - 2.0 * i / n, b = 1.0 - 2.0 * (i + 1) / n;
+    xs.insert(xs.end(), {a, b});
+    ys.insert(ys.end(), {bands.expected[static_cast<std::size_t>(i)], bands.expected[static_cast<std::size_t>(i)]});
+  }
+  plot.line(xs, ys, IM_COL32(255, 190, 60, 255), 2.0f);
+  plot.legend({{"observed", IM_COL32(90, 170, 255, 200)}, {"expected", IM_COL32(255, 190, 60, 255)}});
+}
+
+}  // namespace
+
+DiscPoint project_to_disc(float u, float v) {
+  const float cos_theta = std::clamp(1.0f - 2.0f * v, -1.0f, 1.0f);
+  const float phi = 2.0f * std::numbers::pi_v<float> * u;
+  DiscPoint d;
+  d.lower = cos_theta < 0.0f;
+  // 1 - |cos| is the solid angle from the disc's centre over 2 pi: r^2 keeps areas equal.
+  const float r = std::sqrt(std::max(0.0f, 1.0f - std::abs(cos_theta)));
+  d.x = r * std::cos(phi);
+  d.y = r * std::sin(phi);
+  return d;
+}
+
+std::optional<PixelHit> pixel_at(float px, float py, float rect_x, float rect_y, float rect_w, float rect_h,
+                                 int image_width, int image_height) {
+  if (!(rect_w > 0.0f) || !(rect_h > 0.0f) || image_width <= 0 || image_height <= 0) return std::nullopt;
+  const float fx = (px - rect_x) / rect_w, fy = (py - rect_y) / rect_h;
+  if (!(fx >= 0.0f && fx < 1.0f && fy >= 0.0f && fy < 1.0f)) return std::nullopt;
+  PixelHit hit;
+  hit.x = std::min(image_width - 1, static_cast<int>(fx * static_cast<float>(image_width)));
+  hit.y = std::min(image_height - 1, static_cast<int>(fy * static_cast<float>(image_height)));
+  return hit;
+}
+
+BandHistogram cos_theta_bands(const ProbeChiSquare& chi) {
+  BandHistogram b;
+  b.observed.assign(static_cast<std::size_t>(std::max(0, chi.z_cells)), 0.0);
+  b.expected.assign(b.observed.size(), 0.0);
+  for (int row = 0; row < chi.z_cells; ++row)
+    for (int col = 0; col < chi.phi_cells; ++col) {
+      const std::size_t i = static_cast<std::size_t>(row) * chi.phi_cells + col;
+      if (i < chi.observed.size()) b.observed[static_cast<std::size_t>(row)] += static_cast<double>(chi.observed[i]);
+      if (i < chi.expected.size()) b.expected[static_cast<std::size_t>(row)] += chi.expected[i];
+    }
+  return b;
+}
+
+void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strategy& strategy, std::uint64_t seed,
+                 int x, int y) {
+  // A running check reads the old plan and scene through its own copies of the pointers.
+  s.has_point = true;
+  s.open = true;
+  s.pixel_x = x;
+  s.pixel_y = y;
+  s.strategy_text = strategy.to_string();
+  s.chi.reset();
+  s.scene = std::move(scene);
+  s.point = first_diffuse_hit(*s.scene, x, y, seed);
+  s.samples.clear();
+  std::fill(s.technique_counts.begin(), s.technique_counts.end(), 0);
+  try {
+    s.plan = std::make_shared<const SamplingPlan>(SamplingPlan::make(strategy, *s.scene));
+  } catch (const InputError&) {
+    s.plan.reset();
+  }
+  if (s.point.found && s.plan) {
+    s.samples = probe_directions(*s.plan, s.point, kProbeDirections, seed);
+    for (const ProbeSample& p : s.samples)
+      ++s.technique_counts[static_cast<std::size_t>(p.technique < 0 ? kTechniqueCount : p.technique)];
+  }
+  s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
+                            s.point, kMapWidth, kMapHeight);
+  s.cosine_map = make_map("cosine alone", *s.scene, Strategy::single(Technique::Cosine), s.point, kLobeWidth,
+                          kLobeHeight);
+  s.light_map = make_map("light alone", *s.scene, Strategy::single(Technique::Light), s.point, kLobeWidth,
+                         kLobeHeight);
+}
+
+void start_probe_chi_square(ProbeState& s, double now) {
+  if (s.chi_running() || !s.plan || !s.point.found || s.plan->nee_mis) return;
+  s.chi.reset();
+  s.chi_started = now;
+  s.chi_job = std::async(std::launch::async, [plan = s.plan, scene = s.scene, at = s.point] {
+    (void)scene;  // the plan points into it
+    return probe_chi_square(*plan, at, kChiSamples, 1);
+  });
+}
+
+bool poll_probe_chi_square(ProbeState& s, double now) {
+  if (!s.chi_job.valid() || s.chi_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+  s.chi = s.chi_job.get();
+  s.chi_seconds = now - s.chi_started;
+  return true;
+}
+
+void draw_probe_panel(ProbeState& s, double now, float area_width, float area_height) {
+  if (!s.open || !s.has_point) return;
+  poll_probe_chi_square(s, now);
+  // Over the side panel, reaching into the image area only as far as it must:
+  // the image stays clickable for the next probe. Movable.
+  (void)area_width, (void)area_height;
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float w = std::min(display.x - 20.0f, 600.0f), h = std::min(display.y - 20.0f, 760.0f);
+  ImGui::SetNextWindowPos(ImVec2(display.x - w - 10.0f, 10.0f), ImGuiCond_Appearing);
+  ImGui::SetNextWindowSize(ImVec2(w, h), ImGuiCond_Appearing);
+  ImGui::SetNextWindowBgAlpha(0.97f);
+  if (!ImGui::Begin("Pixel probe (P)", &s.open, ImGuiWindowFlags_NoSavedSettings)) {
+    ImGui::End();
+    return;
+  }
+  ImGui::Text("pixel (%d, %d)   %s", s.pixel_x, s.pixel_y, s.strategy_text.c_str());
+  if (!s.point.found) {
+    ImGui::TextColored(kAmber, "This pixel's ray leaves the scene or reaches a light before a diffuse surface.");
+    ImGui::End();
+    return;
+  }
+  ImGui::TextColored(kDim, "hit (%.0f, %.0f, %.0f)  normal (%.2f, %.2f, %.2f)%s", s.point.point.x, s.point.point.y,
+                     s.point.point.z, s.point.normal.x, s.point.normal.y, s.point.normal.z,
+                     s.point.specular_bounces ? "  after mirror/glass" : "");
+
+  const float line = ImGui::GetTextLineHeight();
+  const float spacing = ImGui::GetStyle().ItemSpacing.x;
+  const float avail = ImGui::GetContentRegionAvail().x;
+  const float radius = std::clamp((avail - 210.0f) / 3.6f, 55.0f, 90.0f);
+  ImGui::TextColored(kDim, "%d directions drawn here, by technique (equal-area view)",
+                     static_cast<int>(s.samples.size()));
+  ImGui::BeginGroup();
+  directions_view(s, radius);
+  ImGui::EndGroup();
+  ImGui::SameLine();
+  ImGui::BeginGroup();
+  ImGui::Dummy(ImVec2(1.0f, line * 0.5f));
+  legend(s);
+  ImGui::EndGroup();
+
+  ImGui::Separator();
+  // The strategy's map with its colour bar, and beside it the two lobes it mixes.
+  const float bar_w = ImGui::CalcTextSize("1e+04").x + 22.0f;
+  const float lobe_w = std::max(120.0f, avail * 0.3f);
+  const float map_w = std::max(160.0f, avail - bar_w - lobe_w - 2.0f * spacing);
+  const float map_h = map_w * 0.5f;
+  ImGui::BeginGroup();
+  draw_map(s.strategy_map, ImVec2(map_w, map_h), s.log_scale);
+  ImGui::Checkbox("log colour scale (4 decades)", &s.log_scale);
+  ImGui::EndGroup();
+  ImGui::SameLine();
+  ImGui::BeginGroup();
+  const double top = s.strategy_map.max_value;
+  draw::colour_bar(ImVec2(bar_w, map_h + line + 4.0f), s.log_scale ? top * 1e-4 : 0.0, top, s.log_scale, "pdf");
+  ImGui::EndGroup();
+  ImGui::SameLine();
+  ImGui::BeginGroup();
+  draw_map(s.cosine_map, ImVec2(lobe_w, lobe_w * 0.5f), s.log_scale);
+  draw_map(s.light_map, ImVec2(lobe_w, lobe_w * 0.5f), s.log_scale);
+  ImGui::EndGroup();
+  ImGui::TextColored(kDim, "phi across, cos(theta) from +1 (top) to -1; line: the horizon. Maxima: %.3g, %.3g, %.3g",
+                     s.strategy_map.max_value, s.cosine_map.max_value, s.light_map.max_value);
+
+  ImGui::Separator();
+  chi_square_section(s, now);
+  ImGui::End();
+}
+
+}  // namespace pdflab::ui

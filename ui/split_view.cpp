@@ -1,0 +1,153 @@
+#include "ui/split_view.h"
+
+#include "renderer/metrics/metrics.h"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace pdflab::ui {
+
+namespace {
+
+const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
+const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
+const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
+
+void side_box(const char* id, const char* side, const SideFigures& f, ImVec2 pos, ImVec2 pivot) {
+  ImGui::SetNextWindowPos(pos, ImGuiCond_Always, pivot);
+  ImGui::SetNextWindowBgAlpha(0.72f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+  if (ImGui::Begin(id, nullptr, flags)) {
+    ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.4f, 1.0f), "%s", side);
+    ImGui::SameLine();
+    ImGui::TextUnformatted(f.strategy.c_str());
+    if (!f.unbiased) {
+      ImGui::SameLine();
+      ImGui::TextColored(kRed, "biased");
+    }
+    ImGui::Text("%u spp  %.1f s  %.2f M samples/s", f.spp, f.seconds, f.samples_per_second * 1e-6);
+    ImGui::Text("noise (rel. std. error)  %s", format_figure(f.noise, true).c_str());
+    if (f.reference_relmse >= 0.0) ImGui::Text("relMSE vs reference  %s", format_figure(f.reference_relmse).c_str());
+    else ImGui::TextColored(kDim, "relMSE (film estimate)  %s", format_figure(f.estimated_relmse).c_str());
+    ImGui::Text("efficiency 1/(relMSE t)  %s%s", format_figure(f.efficiency()).c_str(),
+                f.efficiency_from_reference() ? "" : " (est.)");
+  }
+  ImGui::End();
+}
+
+}  // namespace
+
+SplitThreads split_threads(int hardware_threads) {
+  const int half = std::max(1, hardware_threads / 2);
+  return {half, half};
+}
+
+bool SplitDivider::update(float mouse_x, float mouse_y, bool clicked, bool down, float left, float top, float width,
+                          float height, float grab) {
+  if (!(width > 0.0f)) return false;
+  if (dragging && !down) dragging = false;
+  if (clicked) {
+    const bool inside_y = mouse_y >= top && mouse_y < top + height;
+    dragging = inside_y && std::abs(mouse_x - x(left, width)) <= grab;
+  }
+  if (dragging) fraction = std::clamp((mouse_x - left) / width, 0.0f, 1.0f);
+  return dragging;
+}
+
+double SideFigures::efficiency() const {
+  const double relmse = reference_relmse >= 0.0 ? reference_relmse : estimated_relmse;
+  if (!(relmse > 0.0) || !(seconds > 0.0)) return -1.0;
+  return pdflab::efficiency(relmse, seconds);
+}
+
+std::vector<std::string> split_strategy_choices() {
+  return {"cosine",
+          "uniform-hemisphere",
+          "uniform-sphere",
+          "light",
+          "light-sa",
+          "mix:cosine=0.5,light=0.5",
+          "mix:cosine=0.5,light-sa=0.5",
+          "mix:cosine=0.9,light=0.1",
+          "nee-mis"};
+}
+
+std::string format_figure(double value, bool percent) {
+  if (!(value >= 0.0) || !std::isfinite(value)) return "-";
+  char buf[32];
+  if (percent) std::snprintf(buf, sizeof buf, "%.2f%%", value * 100.0);
+  else if (value != 0.0 && (value < 1e-2 || value >= 1e4)) std::snprintf(buf, sizeof buf, "%.2e", value);
+  else std::snprintf(buf, sizeof buf, "%.3g", value);
+  return buf;
+}
+
+void draw_split_overlay(const SplitState& s, float left, float top, float width, float height) {
+  if (!(width > 0.0f)) return;
+  ImDrawList* list = ImGui::GetBackgroundDrawList();
+  const float x = s.divider.x(left, width);
+  const ImU32 line = s.divider.dragging ? IM_COL32(255, 210, 90, 255) : IM_COL32(255, 255, 255, 200);
+  list->AddLine(ImVec2(x, top), ImVec2(x, top + height), IM_COL32(0, 0, 0, 160), 4.0f);
+  list->AddLine(ImVec2(x, top), ImVec2(x, top + height), line, 2.0f);
+  // A grip in the middle, so the line reads as something to drag.
+  const ImVec2 c(x, top + height * 0.5f);
+  list->AddCircleFilled(c, 9.0f, IM_COL32(30, 30, 36, 230), 20);
+  list->AddCircle(c, 9.0f, line, 20, 2.0f);
+  list->AddTriangleFilled(ImVec2(c.x - 6, c.y), ImVec2(c.x - 2, c.y - 4), ImVec2(c.x - 2, c.y + 4), line);
+  list->AddTriangleFilled(ImVec2(c.x + 6, c.y), ImVec2(c.x + 2, c.y + 4), ImVec2(c.x + 2, c.y - 4), line);
+
+  side_box("##split_a", "A", s.a, ImVec2(left + 6.0f, top + 6.0f), ImVec2(0.0f, 0.0f));
+  // Opposite corners: the boxes never cover each other, even on a narrow image.
+  side_box("##split_b", "B", s.b, ImVec2(left + width - 6.0f, top + height - 6.0f), ImVec2(1.0f, 1.0f));
+}
+
+void draw_split_controls(SplitState& s, SplitRequests& requests, float area_width, float area_height) {
+  (void)area_width;
+  ImGui::SetNextWindowPos(ImVec2(8.0f, area_height - 8.0f), ImGuiCond_Always, ImVec2(0.0f, 1.0f));
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing;
+  if (!ImGui::Begin("##split_controls", nullptr, flags)) {
+    ImGui::End();
+    return;
+  }
+  ImGui::TextColored(kDim, "Split A/B (S): same seed, equal time");
+  ImGui::TextColored(kDim, "A: side panel strategy, %d thread%s a side", s.threads_per_side,
+                     s.threads_per_side == 1 ? "" : "s");
+  const float field = ImGui::GetFontSize() * 12.0f;
+  ImGui::SetNextItemWidth(field);
+  if (ImGui::BeginCombo("B strategy", s.b_strategy.c_str())) {
+    for (const std::string& choice : split_strategy_choices())
+      if (ImGui::Selectable(choice.c_str(), choice == s.b_strategy)) {
+        s.b_field = choice;
+        if (choice != s.b_strategy) {
+          s.b_strategy = choice;
+          requests.restart = true;
+        }
+      }
+    ImGui::EndCombo();
+  }
+  ImGui::SetNextItemWidth(field);
+  if (ImGui::InputText("B (any, Enter)", &s.b_field, ImGuiInputTextFlags_EnterReturnsTrue) && s.b_field != s.b_strategy) {
+    s.b_strategy = s.b_field;
+    requests.restart = true;
+  }
+  if (!s.b_error.empty()) ImGui::TextColored(kRed, "%s", s.b_error.c_str());
+  ImGui::SetNextItemWidth(field);
+  if (ImGui::InputTextWithHint("Reference", "reference .pfm (Enter)", &s.reference_path,
+                               ImGuiInputTextFlags_EnterReturnsTrue))
+    requests.load_reference = true;
+  if (!s.reference_status.empty()) {
+    ImGui::SameLine();
+    const bool ok = s.reference_status.rfind("loaded", 0) == 0;
+    ImGui::TextColored(ok ? kGreen : kRed, "%s", s.reference_status.c_str());
+  }
+  ImGui::End();
+}
+
+}  // namespace pdflab::ui

@@ -1,0 +1,68 @@
+#pragma once
+// Small plotting and colour helpers for the teaching views, drawn with ImGui's
+// draw list (ImPlot is not packaged on Debian). The axis and tick maths is
+// plain code so it can be tested without an ImGui context.
+#include <imgui.h>
+
+#include <string>
+#include <vector>
+
+namespace pdflab::ui::draw {
+
+// A data range mapped onto 0..1, linearly or by log10 (log axes clamp values
+// at or below zero to the low end instead of producing NaN).
+struct Axis {
+  double lo = 0.0, hi = 1.0;
+  bool log = false;
+  double to_unit(double v) const;
+};
+
+// Tick values at 1, 2 or 5 times a power of ten, at most about `max_ticks`.
+std::vector<double> nice_ticks(double lo, double hi, int max_ticks = 6);
+// Powers of ten inside [lo, hi] (lo > 0).
+std::vector<double> decade_ticks(double lo, double hi);
+// A range that contains every finite value of `values` (and `extra`), widened
+// a little so curves do not touch the frame; positive-only for log axes.
+Axis fit_axis(const std::vector<double>& values, bool log, double pad = 0.05);
+// Short tick label: 0.5, 2, 1e-3, 1e+04.
+std::string tick_label(double v);
+
+// Colour map for densities: dark blue through magenta and orange to pale
+// yellow, rising in brightness so it still reads in grey. t is clamped to 0..1.
+ImU32 colormap(float t);
+// One colour per sampling technique (Technique index); -1 (no direction) grey.
+ImU32 technique_colour(int technique);
+
+// A plot frame placed at the cursor; ImGui::Dummy reserves its space.
+class Plot {
+ public:
+  Plot(const char* title, ImVec2 size, Axis x, Axis y, const char* x_label = nullptr);
+  ~Plot();
+  Plot(const Plot&) = delete;
+  Plot& operator=(const Plot&) = delete;
+
+  ImVec2 at(double x, double y) const;
+  const Axis& x() const { return x_; }
+  const Axis& y() const { return y_; }
+  ImDrawList* list() const { return list_; }
+
+  void line(const std::vector<double>& xs, const std::vector<double>& ys, ImU32 colour, float thickness = 1.6f) const;
+  // Filled band between lo and hi along xs (a confidence band).
+  void band(const std::vector<double>& xs, const std::vector<double>& lo, const std::vector<double>& hi,
+            ImU32 colour) const;
+  // Bars of equal width starting at x0.
+  void bars(double x0, double width, const std::vector<double>& heights, ImU32 fill) const;
+  void hline(double y, ImU32 colour, bool dashed = true) const;
+  // Legend rows in the top-right (or top-left) corner.
+  void legend(const std::vector<std::pair<std::string, ImU32>>& entries, bool left = false) const;
+
+ private:
+  ImDrawList* list_ = nullptr;
+  ImVec2 min_{}, max_{};  // the data area
+  Axis x_, y_;
+};
+
+// A vertical colour bar with its range as labels, `size` from the cursor.
+void colour_bar(ImVec2 size, double lo, double hi, bool log, const char* label);
+
+}  // namespace pdflab::ui::draw
