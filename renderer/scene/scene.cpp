@@ -73,42 +73,43 @@ inline bool hit_sphere(const Sphere& sphere, const Ray& ray, float t_max, float&
   return true;
 }
 
-// Four quads per step in SIMD lanes (GCC/Clang vector extensions: SSE on
-// x86-64, NEON on ARM), with no branches: which quad is nearest is
+// kQuadLanes quads per step in SIMD lanes (GCC/Clang vector extensions: SSE,
+// AVX or AVX-512 on x86-64 as the build targets, NEON on ARM), with no branches: which quad is nearest is
 // unpredictable, and a mispredicted branch costs more than the arithmetic.
 // Each lane keeps its own nearest hit; the lanes are reduced at the end.
-typedef float F4 __attribute__((vector_size(16)));
-typedef std::int32_t I4 __attribute__((vector_size(16)));
+constexpr int kLanes = QuadBatch::kQuadLanes;
+typedef float FV __attribute__((vector_size(4 * kLanes)));
+typedef std::int32_t IV __attribute__((vector_size(4 * kLanes)));
 
-inline F4 load4(const float* p) {
-  F4 v;
+inline FV load(const float* p) {
+  FV v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
 
 inline int closest_in_batch(const QuadBatch& b, const Ray& ray, float& closest) {
-  static_assert(QuadBatch::kQuadLanes % 4 == 0);
-  const F4 ox = ray.origin.x - F4{}, oy = ray.origin.y - F4{}, oz = ray.origin.z - F4{};
-  const F4 dx = ray.direction.x - F4{}, dy = ray.direction.y - F4{}, dz = ray.direction.z - F4{};
-  const F4 zero{}, one = 1.0f - F4{};
-  F4 best_t = closest - F4{};
-  I4 best_i = -1 - I4{};
-  I4 index = I4{0, 1, 2, 3};
-  for (int i = 0; i < b.padded; i += 4, index += 4) {
-    const F4 nx = load4(&b.nx[i]), ny = load4(&b.ny[i]), nz = load4(&b.nz[i]);
-    const F4 denom = nx * dx + ny * dy + nz * dz;
-    const F4 t = (load4(&b.d[i]) - (nx * ox + ny * oy + nz * oz)) / denom;
-    const F4 rx = ox + dx * t - load4(&b.qx[i]);
-    const F4 ry = oy + dy * t - load4(&b.qy[i]);
-    const F4 rz = oz + dz * t - load4(&b.qz[i]);
-    const F4 a = rx * load4(&b.ax[i]) + ry * load4(&b.ay[i]) + rz * load4(&b.az[i]);
-    const F4 c = rx * load4(&b.bx[i]) + ry * load4(&b.by[i]) + rz * load4(&b.bz[i]);
-    const I4 hit = (t > zero) & (t < best_t) & (a >= zero) & (a <= one) & (c >= zero) & (c <= one);
+  const FV ox = ray.origin.x - FV{}, oy = ray.origin.y - FV{}, oz = ray.origin.z - FV{};
+  const FV dx = ray.direction.x - FV{}, dy = ray.direction.y - FV{}, dz = ray.direction.z - FV{};
+  const FV zero{}, one = 1.0f - FV{};
+  FV best_t = closest - FV{};
+  IV best_i = -1 - IV{};
+  IV index{};
+  for (int lane = 0; lane < kLanes; ++lane) index[lane] = lane;
+  for (int i = 0; i < b.padded; i += kLanes, index += kLanes) {
+    const FV nx = load(&b.nx[i]), ny = load(&b.ny[i]), nz = load(&b.nz[i]);
+    const FV denom = nx * dx + ny * dy + nz * dz;
+    const FV t = (load(&b.d[i]) - (nx * ox + ny * oy + nz * oz)) / denom;
+    const FV rx = ox + dx * t - load(&b.qx[i]);
+    const FV ry = oy + dy * t - load(&b.qy[i]);
+    const FV rz = oz + dz * t - load(&b.qz[i]);
+    const FV a = rx * load(&b.ax[i]) + ry * load(&b.ay[i]) + rz * load(&b.az[i]);
+    const FV c = rx * load(&b.bx[i]) + ry * load(&b.by[i]) + rz * load(&b.bz[i]);
+    const IV hit = (t > zero) & (t < best_t) & (a >= zero) & (a <= one) & (c >= zero) & (c <= one);
     best_t = hit ? t : best_t;
     best_i = hit ? index : best_i;
   }
   int best = -1;
-  for (int lane = 0; lane < 4; ++lane) {
+  for (int lane = 0; lane < kLanes; ++lane) {
     const bool nearer = best_t[lane] < closest;
     best = nearer ? best_i[lane] : best;
     closest = nearer ? best_t[lane] : closest;

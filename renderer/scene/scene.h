@@ -64,7 +64,9 @@ struct Camera {
 // The quads again as structure-of-arrays, padded to a multiple of kQuadLanes
 // with quads that can never be hit, so the intersection loop vectorises.
 struct QuadBatch {
-  #if defined(__AVX__)
+#if defined(__AVX512F__)
+  static constexpr int kQuadLanes = 16;
+#elif defined(__AVX__)
   static constexpr int kQuadLanes = 8;
 #else
   static constexpr int kQuadLanes = 4;
