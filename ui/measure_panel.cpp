@@ -69,7 +69,9 @@ void draw_colour_bar(const ColourScale& scale, float width) {
 
 void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, const MeasureState& m) {
   const ViewMode mode = settings.measure.view_mode;
-  const float width = std::clamp(area.width - 40.0f, 160.0f, ImGui::GetFontSize() * 18.0f);
+  // Narrower than the area, so the window never pokes out of its left edge.
+  const float width = std::min(area.width - 40.0f, ImGui::GetFontSize() * 18.0f);
+  if (width < 80.0f) return;
   // Top right of the image area, clear of the badges at its top left.
   ImGui::SetNextWindowPos(ImVec2(area.x + area.width - 8.0f, area.y + 8.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowBgAlpha(0.8f);
@@ -77,11 +79,10 @@ void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, c
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
   if (ImGui::Begin("##view legend", nullptr, flags)) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + width);
     ImGui::TextColored(kAmber, "View: %s (V)", view_mode_label(mode));
     if (!m.layer_ok) {
-      ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + width);
       ImGui::TextColored(kDim, "Showing the image: %s.", m.layer_why.empty() ? "nothing to show" : m.layer_why.c_str());
-      ImGui::PopTextWrapPos();
     } else if (mode == ViewMode::Drops) {
       const char* names[] = {"pdf zero or negative", "pdf NaN or infinite", "radiance not finite", "several reasons"};
       std::uint64_t total = 0;
@@ -94,17 +95,18 @@ void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, c
         ImGui::SameLine();
         const std::uint64_t n = m.layer.drop_pixels[static_cast<std::size_t>(r)];
         total += n;
-        ImGui::Text("%-22s %llu px", names[r], static_cast<unsigned long long>(n));
+        ImGui::Text("%s: %llu px", names[r], static_cast<unsigned long long>(n));
       }
       ImGui::TextColored(kDim, total == 0 ? "No pixel dropped a sample." : "Other pixels are dimmed.");
     } else {
       ImGui::TextColored(kDim, "%s", m.layer.scale.title.c_str());
       draw_colour_bar(m.layer.scale, width);
       if (mode == ViewMode::RelativeError)
-        ImGui::TextColored(kDim, "mean: %.4f  (sqrt of var. of the mean / mean)", m.figures.mean_relative_standard_error);
+        ImGui::TextColored(kDim, "mean %.4f; per pixel: standard error of the mean / mean", m.figures.mean_relative_standard_error);
       else
         ImGui::TextColored(kDim, "blue: darker than the reference, red: brighter");
     }
+    ImGui::PopTextWrapPos();
   }
   ImGui::End();
 }
