@@ -406,6 +406,10 @@ void Viewer::Impl::on_key(int key) {
       settings.sampling = ui::preset_sampling(static_cast<ui::Preset>(key - GLFW_KEY_0));
       apply_render_settings();
       break;
+    case GLFW_KEY_4:
+      settings.sampling = ui::SamplingSettings::from(Strategy::nee());
+      apply_render_settings();
+      break;
     case GLFW_KEY_V: settings.measure.view_mode = ui::next_view_mode(settings.measure.view_mode); break;
     case GLFW_KEY_C: settings.measure.show_plot = !settings.measure.show_plot; break;
     case GLFW_KEY_P: measure.curves.pin(); break;

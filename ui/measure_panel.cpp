@@ -185,8 +185,15 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
   dl->AddText(ImVec2((a.x + b.x - ImGui::CalcTextSize(xlabel).x) * 0.5f, b.y + font * 1.25f), text, xlabel);
 
   // Legend, top right inside the frame.
+  const auto curve_name = [](const Curve& c, const char* prefix) {
+    return prefix + (c.label.empty() ? std::string("-") : c.label) + (c.estimated ? " (est.)" : "");
+  };
+  // Right-aligned on the longest entry, so a long mixture name stays inside the frame.
+  float widest = ImGui::CalcTextSize("1/sqrt(N) slope").x;
+  for (std::size_t i = 0; i < curves.size(); ++i)
+    widest = std::max(widest, ImGui::CalcTextSize(curve_name(*curves[i], i + 1 < curves.size() ? "pin: " : "now: ").c_str()).x);
   float ly = a.y + 4.0f;
-  const float lx = b.x - font * 14.0f;
+  const float lx = std::max(a.x + 4.0f, b.x - widest - font * 2.4f);
   const auto legend_line = [&](ImU32 colour, const std::string& label, bool dashed) {
     if (dashed) {
       for (float k = 0.0f; k < 3.0f; k += 1.0f)
@@ -197,9 +204,6 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
     }
     dl->AddText(ImVec2(lx + font * 2.0f, ly), text, label.c_str());
     ly += font * 1.15f;
-  };
-  const auto curve_name = [](const Curve& c, const char* prefix) {
-    return prefix + (c.label.empty() ? std::string("-") : c.label) + (c.estimated ? " (est.)" : "");
   };
   for (std::size_t i = 0; i + 1 < curves.size(); ++i)
     legend_line(kPinColours[i % std::size(kPinColours)], curve_name(*curves[i], "pin: "), false);

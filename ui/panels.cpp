@@ -300,6 +300,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"1", "preset: cosine only"},
         {"2", "preset: light only"},
         {"3", "preset: book 50/50 (cosine + light)"},
+        {"4", "next-event estimation (nee-mis)"},
         {"V", "next view: image, noise heat map, difference, drops"},
         {"C", "show / hide the convergence plot"},
         {"P", "pin the running convergence curve"},
