@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
   app.add_option("--spp", view_spp, "With --screenshot: samples per pixel to render before saving")
       ->check(CLI::Range(1u, 1u << 30));
   app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
+  std::string view_reference;
+  app.add_option("--reference", view_reference, "Reference image (PFM) for live error figures in the viewer");
 
   pdflab::RenderOptions ro;
   CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
@@ -124,6 +126,7 @@ int main(int argc, char** argv) {
     vo.strategy = view_strategy;
     vo.spp = view_spp;
     vo.screenshot = screenshot;
+    vo.reference = view_reference;
     return pdflab::run_viewer(vo);
 #else
     // Built without the viewer: render the default scene headlessly instead.

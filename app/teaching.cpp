@@ -54,7 +54,6 @@ void TeachingViews::enter_split(RenderSession& main) {
   SessionOptions options;
   options.background_priority = true;
   options.preview = true;
-  options.publish_noise = true;
   options.on_image = on_image_;
   options.threads = threads.a;
   a_ = std::make_unique<RenderSession>(options);
@@ -119,7 +118,7 @@ void TeachingViews::pull(RenderSession& session, std::vector<float>& image, Imag
     stale = true;
     new_image_ = true;
     if (!info.preview) {
-      f.noise = info.noise;
+      f.noise = info.mean_relative_standard_error;
       f.estimated_relmse = info.estimated_relmse;
       f.reference_relmse = -1.0;
       if (!reference_.empty() && reference_width_ == info.width && reference_height_ == info.height)

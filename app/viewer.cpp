@@ -7,8 +7,10 @@
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 #include "ui/display.h"
+#include "ui/measure_panel.h"
 #include "ui/panels.h"
 #include "ui/screenshot.h"
+#include "ui/view_texture.h"
 
 // glad before GLFW: glad provides the GL declarations, GLFW must not.
 #include <glad/gl.h>
@@ -83,6 +85,8 @@ struct Viewer::Impl {
   GLFWwindow* window = nullptr;
   bool imgui_ready = false;
   std::unique_ptr<ui::ImageDisplay> display;
+  std::unique_ptr<ui::ViewTexture> view_texture;
+  ui::MeasureState measure;
   std::unique_ptr<RenderSession> session;
   std::unique_ptr<TeachingViews> teaching;
 
@@ -91,6 +95,7 @@ struct Viewer::Impl {
   std::shared_ptr<const Scene> render_scene;  // with depth and resolution applied
   int render_scene_depth = -1;
   float render_scene_scale = -1.0f;
+  bool render_scene_override = false;  // rendered at the reference's size
 
   ui::ViewerSettings settings;
   ui::ViewerSettings applied;  // what the session renders now
@@ -142,6 +147,8 @@ struct Viewer::Impl {
     settle_frames = 2;
   }
   void fill_status();
+  void load_reference(const std::string& path);
+  void handle_measure_requests(const ui::MeasureRequests& r);
 };
 
 void Viewer::Impl::open(const ViewerOptions& o) {
@@ -161,6 +168,10 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   settings.max_depth = scene.max_depth;
   settings.stop_spp = cli_mode() ? options.spp : o.spp;
   settings.screenshot_dir = default_screenshot_dir();
+  if (!o.reference.empty()) {
+    measure.set_reference(ui::load_reference(o.reference));  // a bad file is bad input, before any window
+    settings.measure.reference_field = o.reference;
+  }
   scene_path = o.scene;
   base_scene = std::make_shared<const Scene>(std::move(scene));
   status.scene_files = list_scene_files();
@@ -244,6 +255,7 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   imgui_ready = true;
 
   display = std::make_unique<ui::ImageDisplay>();
+  view_texture = std::make_unique<ui::ViewTexture>();
   std::string error;
   if (!display->init(error)) throw std::runtime_error("display shaders: " + error);
 }
@@ -293,6 +305,7 @@ void Viewer::Impl::close() {
   session.reset();  // workers stop first: nothing renders into a closing viewer
   if (save_job.valid()) save_job.wait();
   display.reset();
+  view_texture.reset();
   if (imgui_ready) {
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -306,11 +319,15 @@ void Viewer::Impl::close() {
 
 bool Viewer::Impl::apply_render_settings() {
   const Strategy strategy = settings.sampling.strategy();
-  if (all_zero(strategy)) {
+  if (!strategy.nee_mis && all_zero(strategy)) {
     status.settings_error = "Every mixture weight is 0; still showing the last valid strategy.";
     return false;
   }
+  const bool overridden = settings.width_override > 0 && settings.height_override > 0;
   if (!render_scene || render_scene_depth != settings.max_depth || render_scene_scale != settings.resolution_scale ||
+      render_scene_override != overridden ||
+      (overridden && (render_scene->camera.width != settings.width_override ||
+                      render_scene->camera.height != settings.height_override)) ||
       render_scene.get() == base_scene.get()) {
     auto scene = std::make_shared<Scene>(*base_scene);
     scene->max_depth = settings.max_depth;
@@ -320,10 +337,15 @@ bool Viewer::Impl::apply_render_settings() {
     };
     cam.width = scaled(base_scene->camera.width);
     cam.height = scaled(base_scene->camera.height);
+    if (overridden) {
+      cam.width = settings.width_override;
+      cam.height = settings.height_override;
+    }
     cam.prepare();
     render_scene = std::move(scene);
     render_scene_depth = settings.max_depth;
     render_scene_scale = settings.resolution_scale;
+    render_scene_override = overridden;
   }
   RenderSettings rs;
   rs.scene = render_scene;
@@ -389,6 +411,13 @@ void Viewer::Impl::on_key(int key) {
       settings.sampling = ui::preset_sampling(static_cast<ui::Preset>(key - GLFW_KEY_0));
       apply_render_settings();
       break;
+    case GLFW_KEY_4:
+      settings.sampling = ui::SamplingSettings::from(Strategy::nee());
+      apply_render_settings();
+      break;
+    case GLFW_KEY_V: settings.measure.view_mode = ui::next_view_mode(settings.measure.view_mode); break;
+    case GLFW_KEY_G: settings.measure.show_plot = !settings.measure.show_plot; break;
+    case GLFW_KEY_K: measure.curves.pin(); break;  // keep
     case GLFW_KEY_H:
     case GLFW_KEY_F1: panel.show_help = !panel.show_help; break;
     default: break;
@@ -397,9 +426,12 @@ void Viewer::Impl::on_key(int key) {
 
 void Viewer::Impl::pull_image() {
   // Never waits for a worker: copy_image only takes the image lock for a copy.
-  if (session->copy_image(image, image_info, image_version)) {
+  if (session->copy_published(measure.published, image_version)) {
+    image = measure.published.rgb;
+    image_info = measure.published.info;
     texture_stale = true;
     report.new_image = true;
+    measure.on_image(session->generation(), applied.sampling.strategy().to_string());
   }
 }
 
@@ -483,6 +515,27 @@ void Viewer::Impl::fill_status() {
   status.can_retry_screenshot = failed_save.has_value() && !save_job.valid();
   status.now = now();
   status.frame_ms = report.work_ms;
+  status.measure = &measure;
+}
+
+void Viewer::Impl::load_reference(const std::string& path) {
+  try {
+    measure.set_reference(ui::load_reference(path));
+  } catch (const std::exception& e) {
+    measure.reference_error = e.what();  // the previous reference stays
+  }
+}
+
+void Viewer::Impl::handle_measure_requests(const ui::MeasureRequests& r) {
+  if (!r.load_reference.empty()) load_reference(r.load_reference);
+  if (r.clear_reference) measure.set_reference({});
+  if (r.render_at_reference_size && measure.reference.loaded()) {
+    settings.width_override = measure.reference.width;
+    settings.height_override = measure.reference.height;
+    apply_render_settings();
+  }
+  if (r.pin_curve) measure.curves.pin();
+  if (r.clear_pins) measure.curves.clear_pins();
 }
 
 Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -538,6 +591,8 @@ bool Viewer::frame(bool paced, bool force_draw) {
     v.display->upload(v.image.data(), v.image_info.data_width, v.image_info.data_height);
     v.texture_stale = false;
   }
+  if (v.measure.refresh_layer(v.settings.measure.view_mode))
+    v.view_texture->upload(v.measure.layer.rgba.data(), v.measure.layer.width, v.measure.layer.height);
 
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
@@ -550,10 +605,18 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
   ui::draw_image_badges(v.settings, v.status);
   {
-    const int image_px = static_cast<int>(panel_width * v.framebuffer_scale);
-    const ui::Viewport image_area{0, 0, std::max(0, fb_w - image_px), fb_h};
-    v.teaching->draw_ui(*v.session, ui::fit_image(image_area, v.image_info.width, v.image_info.height), fb_h,
-                        v.framebuffer_scale, io.DisplaySize.x - panel_width, io.DisplaySize.y);
+    // The image's place in ImGui coordinates, for the layers and plot drawn over it.
+    const float fbs = v.framebuffer_scale;
+    const int panel_fb = static_cast<int>(panel_width * fbs);
+    const ui::Viewport image_fb =
+        ui::fit_image({0, 0, std::max(0, fb_w - panel_fb), fb_h}, v.image_info.width, v.image_info.height);
+    const ui::ImageRect image_rect{static_cast<float>(image_fb.x) / fbs,
+                                   static_cast<float>(fb_h - image_fb.y - image_fb.height) / fbs,
+                                   static_cast<float>(image_fb.width) / fbs, static_cast<float>(image_fb.height) / fbs};
+    const ui::ImageRect area_rect{0.0f, 0.0f, io.DisplaySize.x - panel_width, io.DisplaySize.y};
+    ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
+    v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, io.DisplaySize.x - panel_width,
+                        io.DisplaySize.y);
   }
   ImGui::Render();
 
@@ -565,6 +628,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
     v.applied.stop_spp = v.settings.stop_spp;
   }
   if (requests.screenshot) v.screenshot_wanted = true;
+  v.handle_measure_requests(requests.measure);
   if (requests.retry_screenshot && v.failed_save) {
     ui::ScreenshotData data = std::move(*v.failed_save);
     v.failed_save.reset();

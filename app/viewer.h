@@ -16,6 +16,7 @@ struct ViewerOptions {
   std::string screenshot;  // PNG path; the PFM and JSON go beside it
   // Window size in screen coordinates (0: fit the image and the panel).
   int window_width = 0, window_height = 0;
+  std::string reference;  // PFM to measure the error against (empty: none)
 };
 
 // Runs the viewer until the window closes. Returns the process exit status;

@@ -1,6 +1,7 @@
 #include "ui/panels.h"
 
 #include "renderer/integrator/integrator.h"
+#include "ui/measure_panel.h"
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
@@ -41,17 +42,20 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
 
   // Combo: each technique alone, then the mixture.
   std::string current = s.mixture ? "mixture" : std::string(technique_name(s.single));
+  if (s.nee_mis) current = s.heuristic == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
   if (ImGui::BeginCombo("Strategy", current.c_str())) {
     for (int i = 0; i < kTechniqueCount; ++i) {
       const auto t = static_cast<Technique>(i);
       std::string name(technique_name(t));
       if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
-      if (ImGui::Selectable(name.c_str(), !s.mixture && s.single == t)) {
+      if (ImGui::Selectable(name.c_str(), !s.nee_mis && !s.mixture && s.single == t)) {
+        s.nee_mis = false;
         s.mixture = false;
         s.single = t;
       }
     }
-    if (ImGui::Selectable("mixture", s.mixture)) {
+    if (ImGui::Selectable("mixture", !s.nee_mis && s.mixture)) {
+      s.nee_mis = false;
       if (!s.mixture) {
         // Start the mixture from what was shown, so the image does not jump.
         s.weights = {};
@@ -59,10 +63,19 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
       }
       s.mixture = true;
     }
+    ImGui::Separator();
+    for (const MisHeuristic h : {MisHeuristic::Power, MisHeuristic::Balance}) {
+      const char* label = h == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
+      if (ImGui::Selectable(label, s.nee_mis && s.heuristic == h)) {
+        s.nee_mis = true;
+        s.heuristic = h;
+      }
+    }
     ImGui::EndCombo();
   }
 
-  if (s.mixture) {
+  if (s.nee_mis) draw_nee_explanation();
+  if (s.mixture && !s.nee_mis) {
     const auto norm = s.normalised();
     ImGui::TextColored(kDim, "weight per technique        normalised");
     for (int i = 0; i < kTechniqueCount; ++i) {
@@ -87,7 +100,7 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
   }
 
   const Strategy strategy = s.strategy();
-  bool any = false;
+  bool any = strategy.nee_mis;
   for (float w : strategy.weights) any = any || w > 0.0f;
   if (any) {
     ImGui::TextUnformatted(strategy.to_string().c_str());
@@ -151,8 +164,10 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
       std::snprintf(label, sizeof label, "%.0f%%  (%dx%d)", scale * 100.0,
                     std::max(1, static_cast<int>(static_cast<float>(status.base_width) * scale + 0.5f)),
                     std::max(1, static_cast<int>(static_cast<float>(status.base_height) * scale + 0.5f)));
-      if (ImGui::Selectable(label, scale == settings.resolution_scale) && scale != settings.resolution_scale) {
+      if (ImGui::Selectable(label, scale == settings.resolution_scale) &&
+          (scale != settings.resolution_scale || settings.width_override > 0)) {
         settings.resolution_scale = scale;
+        settings.width_override = settings.height_override = 0;
         requests.restart_render = true;
       }
     }
@@ -180,6 +195,7 @@ void display_section(ViewerSettings& settings) {
   ImGui::SameLine();
   ImGui::RadioButton("sRGB", &transfer, 1);
   settings.srgb = transfer == 1;
+  draw_view_mode_selector(settings);
 }
 
 void statistics_section(const ViewerSettings& settings, const UiStatus& status) {
@@ -261,7 +277,8 @@ void draw_side_panel(float width, float display_height, ViewerSettings& settings
   if (ImGui::CollapsingHeader("Scene and render", ImGuiTreeNodeFlags_DefaultOpen))
     scene_section(settings, state, status, requests);
   if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics_section(settings, status);
-  if (ImGui::CollapsingHeader("Display")) display_section(settings);
+  if (ImGui::CollapsingHeader("Measure", ImGuiTreeNodeFlags_DefaultOpen)) draw_measure_section(settings, status, requests);
+  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings);
   if (ImGui::CollapsingHeader("Screenshot", ImGuiTreeNodeFlags_DefaultOpen))
     screenshot_section(settings, status, requests);
   ImGui::PopItemWidth();
@@ -283,6 +300,10 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"1", "preset: cosine only"},
         {"2", "preset: light only"},
         {"3", "preset: book 50/50 (cosine + light)"},
+        {"4", "next-event estimation (nee-mis)"},
+        {"V", "next view: image, noise heat map, difference, drops"},
+        {"G", "show / hide the convergence plot (graph)"},
+        {"K", "keep (pin) the running convergence curve"},
         {"F12", "screenshot: PNG + PFM + JSON"},
         {"S", "split screen A/B: two strategies, equal time"},
         {"P", "pixel probe: click a pixel (C: chi-square)"},

@@ -3,6 +3,7 @@
 namespace pdflab::ui {
 
 Strategy SamplingSettings::strategy() const {
+  if (nee_mis) return Strategy::nee(heuristic);
   if (!mixture) return Strategy::single(single);
   Strategy s;
   s.weights = weights;
@@ -11,6 +12,14 @@ Strategy SamplingSettings::strategy() const {
 
 SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   SamplingSettings out;
+  if (strategy.nee_mis) {
+    out.nee_mis = true;
+    out.heuristic = strategy.heuristic;
+    // What the mixture sliders show if the user leaves nee-mis: the book's 50/50.
+    out.weights[static_cast<int>(Technique::Cosine)] = 0.5f;
+    out.weights[static_cast<int>(Technique::Light)] = 0.5f;
+    return out;
+  }
   int used = 0;
   for (int i = 0; i < kTechniqueCount; ++i)
     if (strategy.weights[i] > 0.0f) {

@@ -3,6 +3,7 @@
 // viewer turns it into RenderSettings. Nothing here touches threads or OpenGL.
 #include "renderer/sampling/strategy.h"
 #include "renderer/session/session.h"
+#include "ui/measure.h"
 
 #include <array>
 #include <cstdint>
@@ -17,6 +18,10 @@ struct SamplingSettings {
   bool mixture = true;
   Technique single = Technique::Cosine;
   std::array<float, kTechniqueCount> weights{};
+  // Next-event estimation with MIS: its own mode, neither one technique nor a
+  // mixture (two samples per vertex); overrides the two above while set.
+  bool nee_mis = false;
+  MisHeuristic heuristic = MisHeuristic::Power;
 
   Strategy strategy() const;
   static SamplingSettings from(const Strategy& strategy);
@@ -40,6 +45,10 @@ struct ViewerSettings {
   float exposure_ev = 0.0f;
   bool srgb = false;  // false: the book's gamma 2
   std::string screenshot_dir = "screenshots";
+  MeasureSettings measure;
+  // Non-zero: render at exactly this size instead of the scene's times
+  // resolution_scale (set to match a reference image).
+  int width_override = 0, height_override = 0;
 };
 
 inline constexpr std::array<float, 5> kResolutionScales = {0.25f, 0.5f, 1.0f, 1.5f, 2.0f};
@@ -52,6 +61,7 @@ struct UiRequests {
   bool screenshot = false;
   bool retry_screenshot = false;
   std::string load_scene;  // non-empty: try this file
+  MeasureRequests measure;
 };
 
 struct Notice {
@@ -78,6 +88,7 @@ struct UiStatus {
   Notice notice;
   double now = 0.0;
   double frame_ms = 0.0;
+  const MeasureState* measure = nullptr;  // the viewer's; null in tests without one
 };
 
 // Text-field buffers and other panel-local state that is not a setting.

@@ -31,12 +31,14 @@ void Film::reset(int width, int height) {
   sum_.assign(3 * pixel_count(), 0.0);
   sum_sq_.assign(3 * pixel_count(), 0.0);
   count_.assign(pixel_count(), 0);
+  drop_mask_.assign(pixel_count(), 0);
 }
 
 void Film::clear() {
   std::fill(sum_.begin(), sum_.end(), 0.0);
   std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
   std::fill(count_.begin(), count_.end(), 0u);
+  std::fill(drop_mask_.begin(), drop_mask_.end(), std::uint8_t{0});
 }
 
 void Film::mean(std::size_t pixel, double out[3]) const {

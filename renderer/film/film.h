@@ -56,10 +56,18 @@ class Film {
   std::vector<float> mean_rgb() const;
   void mean_rgb(std::vector<float>& out) const;
 
+  // Which drop reasons occurred among a pixel's samples: bit r for DropReason r.
+  // Kept per pixel so a viewer can show where invalid samples come from, not
+  // only how many there were. Written by the worker that owns the pixel's tile.
+  void mark_drops(std::size_t pixel, std::uint8_t reasons) { drop_mask_[pixel] |= reasons; }
+  std::uint8_t drop_mask(std::size_t pixel) const { return drop_mask_[pixel]; }
+  const std::vector<std::uint8_t>& drop_masks() const { return drop_mask_; }
+
  private:
   int width_ = 0, height_ = 0;
   std::vector<double> sum_, sum_sq_;
   std::vector<std::uint32_t> count_;
+  std::vector<std::uint8_t> drop_mask_;
 };
 
 }  // namespace pdflab

@@ -36,6 +36,15 @@ struct DropCounts {
   }
 };
 
+// Bit r set when the count of DropReason r grew from `before` to `after`: the
+// reasons a run of samples (one pixel's) dropped, for Film::mark_drops.
+inline std::uint8_t drop_reason_bits(const DropCounts& before, const DropCounts& after) {
+  std::uint8_t bits = 0;
+  for (int r = 0; r < kDropReasonCount; ++r)
+    if (after.by_reason[r] != before.by_reason[r]) bits |= static_cast<std::uint8_t>(1u << r);
+  return bits;
+}
+
 // Radiance along one camera ray. Returns zero (and counts) when the estimate is not finite.
 Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops);
 

@@ -82,4 +82,27 @@ std::vector<float> relative_standard_error_map(const Film& film, double epsilon)
   return out;
 }
 
+NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon) {
+  map.assign(film.pixel_count(), 0.0f);
+  double rse_sum = 0.0, rel_sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
+    if (film.count(p) < 2) continue;
+    double m[3], v[3];
+    film.mean(p, m);
+    film.variance_of_mean(p, v);
+    const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
+    map[p] = static_cast<float>(rse);
+    rse_sum += rse;
+    for (int c = 0; c < 3; ++c) rel_sum += v[c] / (m[c] * m[c] + epsilon);
+    ++n;
+  }
+  NoiseSummary out;
+  if (n) {
+    out.mean_relative_standard_error = rse_sum / static_cast<double>(n);
+    out.estimated_relmse = rel_sum / (3.0 * static_cast<double>(n));
+  }
+  return out;
+}
+
 }  // namespace pdflab

@@ -39,4 +39,12 @@ double estimated_relmse(const Film& film, double epsilon = kRelMseEpsilon);
 // Per-pixel relative standard error (the heat map's values), luminance-based.
 std::vector<float> relative_standard_error_map(const Film& film, double epsilon = kRelMseEpsilon);
 
+// The three above in one sweep over the film, as a session publishes them after
+// every pass: the map goes to `map` (resized), the two figures are returned.
+struct NoiseSummary {
+  double mean_relative_standard_error = 0.0;
+  double estimated_relmse = 0.0;
+};
+NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon = kRelMseEpsilon);
+
 }  // namespace pdflab

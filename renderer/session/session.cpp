@@ -157,6 +157,10 @@ void RenderSession::finish_pass_locked() {
 
   std::vector<float> rgb;
   film_.mean_rgb(rgb);
+  // One sweep over the film per pass (a few ms at 600x600 against passes of
+  // 30-120 ms), so a viewer shows noise without ever touching the film.
+  noise_ = noise_summary(film_, spare_rse_);
+  spare_drops_ = film_.drop_masks();
   publish_locked(rgb, pass_);
 
   // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
@@ -184,14 +188,21 @@ void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
   info.preview_scale = pass.preview ? pass.preview_scale : 1;
   info.data_width = pass.preview ? pass.width : info.width;
   info.data_height = pass.preview ? pass.height : info.height;
-  if (options_.publish_noise && !pass.preview) {
-    info.noise = mean_relative_standard_error(film_);
-    info.estimated_relmse = estimated_relmse(film_);
+  if (!pass.preview) {
+    info.mean_relative_standard_error = noise_.mean_relative_standard_error;
+    info.estimated_relmse = noise_.estimated_relmse;
   }
   // The UI thread only ever takes image_mutex_, never mutex_.
   {
     std::lock_guard ik(image_mutex_);
     image_.swap(rgb);
+    if (pass.preview) {
+      image_rse_.clear();
+      image_drops_.clear();
+    } else {
+      image_rse_.swap(spare_rse_);
+      image_drops_.swap(spare_drops_);
+    }
     image_width_ = info.width;
     image_height_ = info.height;
     image_info_ = info;
@@ -244,8 +255,10 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
     for (int x = x0; x < x1; ++x) {
       const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +
                                 static_cast<std::size_t>(x);
+      const DropCounts before = drops;
       for (std::uint32_t s = pass.first_sample; s < pass.first_sample + pass.spp; ++s)
         film_.add(pixel, render_pixel_sample(scene, plan_, seed, x, y, s, drops));
+      if (drops.total() != before.total()) film_.mark_drops(pixel, drop_reason_bits(before, drops));
     }
   }
 }
@@ -363,6 +376,17 @@ bool RenderSession::copy_image(std::vector<float>& out, ImageInfo& info, std::ui
   if (image_version_ == version || image_.empty()) return false;
   out = image_;
   info = image_info_;
+  version = image_version_;
+  return true;
+}
+
+bool RenderSession::copy_published(PublishedImage& out, std::uint64_t& version) const {
+  std::lock_guard ik(image_mutex_);
+  if (image_version_ == version || image_.empty()) return false;
+  out.rgb = image_;
+  out.relative_standard_error = image_rse_;
+  out.drop_mask = image_drops_;
+  out.info = image_info_;
   version = image_version_;
   return true;
 }

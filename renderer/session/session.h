@@ -6,6 +6,7 @@
 // Nobody ever waits on a worker except wait_until_done().
 #include "renderer/film/film.h"
 #include "renderer/integrator/integrator.h"
+#include "renderer/metrics/metrics.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/scene/scene.h"
 
@@ -52,10 +53,19 @@ struct ImageInfo {
   std::uint32_t spp = 0;         // samples per pixel in the image (0 for a preview)
   double seconds = 0.0;          // rendering time of the generation when published
   bool preview = false;          // low-resolution first look, not part of the film
-  // With SessionOptions::publish_noise, the film's own noise figures at this
-  // pass (metrics.h); -1 otherwise and for previews.
-  double noise = -1.0;             // mean_relative_standard_error
-  double estimated_relmse = -1.0;  // estimated_relmse
+  // The film's own noise figures at this pass (metrics.h; 0 for a preview):
+  // they need no reference, so a viewer can show them from the first pass on.
+  double mean_relative_standard_error = 0.0;
+  double estimated_relmse = 0.0;
+};
+
+// A published pass with the per-pixel layers a viewer shows beside the mean.
+// For a preview only `rgb` is filled (it has no film behind it).
+struct PublishedImage {
+  std::vector<float> rgb;                      // data_width x data_height mean RGB
+  std::vector<float> relative_standard_error;  // width x height, metrics.h's map
+  std::vector<std::uint8_t> drop_mask;         // width x height, Film::drop_mask bits
+  ImageInfo info;
 };
 
 struct SessionOptions {
@@ -70,10 +80,6 @@ struct SessionOptions {
   // Called by a worker right after each new image is published (a viewer wakes
   // its event loop with it). Must be cheap and safe to call from any thread.
   std::function<void()> on_image;
-  // Fill ImageInfo::noise and estimated_relmse at every full pass. The film is
-  // consistent only between passes, so they are measured there, under the lock
-  // (a pass over the pixels: about a millisecond for 600x600).
-  bool publish_noise = false;
 };
 
 class RenderSession {
@@ -109,6 +115,9 @@ class RenderSession {
   bool copy_image(std::vector<float>& out, int& width, int& height, std::uint64_t& version) const;
   // The buffer as published: info.data_width x info.data_height values.
   bool copy_image(std::vector<float>& out, ImageInfo& info, std::uint64_t& version) const;
+  // The buffer as published with its noise map and drop mask, all of the same
+  // pass. Same contract as copy_image: false when nothing newer than `version`.
+  bool copy_published(PublishedImage& out, std::uint64_t& version) const;
   // The full accumulation (sum, sum of squares, count). Only while paused or
   // done (waits for the pass in flight to end); throws std::logic_error otherwise.
   Film copy_film() const;
@@ -164,6 +173,7 @@ class RenderSession {
   bool preview_due_ = false;          // the next pass of this generation is a preview
   double full_samples_per_second_ = 0.0;  // measured on full passes, sizes the preview
   std::vector<float> preview_;        // preview pixels, written by workers (disjoint)
+  NoiseSummary noise_;                // of the last full pass
 
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<int> next_tile_{0};
@@ -176,6 +186,10 @@ class RenderSession {
   int image_width_ = 0, image_height_ = 0;
   std::uint64_t image_version_ = 0;
   ImageInfo image_info_;
+  std::vector<float> image_rse_;            // published with image_, empty for a preview
+  std::vector<std::uint8_t> image_drops_;
+  std::vector<float> spare_rse_;            // filled under mutex_, then swapped in
+  std::vector<std::uint8_t> spare_drops_;
 };
 
 }  // namespace pdflab

@@ -68,7 +68,6 @@ TEST(SplitView, TwoSessionsGetEqualTimeAndTheSameRandomNumbers) {
   const auto scene = small_scene();
   const SplitThreads threads = split_threads(static_cast<int>(std::max(2u, std::thread::hardware_concurrency())));
   SessionOptions options;
-  options.publish_noise = true;
   options.threads = threads.a;
   RenderSession a(options);
   options.threads = threads.b;
@@ -107,9 +106,9 @@ TEST(SplitView, TwoSessionsGetEqualTimeAndTheSameRandomNumbers) {
   EXPECT_EQ(info_a.spp, 8u);
   EXPECT_EQ(ia, ib);
   // The published noise figures come with full passes.
-  EXPECT_GT(info_a.noise, 0.0);
+  EXPECT_GT(info_a.mean_relative_standard_error, 0.0);
   EXPECT_GT(info_a.estimated_relmse, 0.0);
-  EXPECT_DOUBLE_EQ(info_a.noise, info_b.noise);
+  EXPECT_DOUBLE_EQ(info_a.mean_relative_standard_error, info_b.mean_relative_standard_error);
 }
 
 TEST(ProbeProjection, EqualAreaDiscs) {

@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Regenerates the measuring figures in docs/: the noise heat map, the
+# difference to a reference, the drop overlay, the convergence plot with a
+# pinned curve, and the nee-mis note. The book's scene at 400x400 under Xvfb.
+#   tests/gui/capture_measure_docs.sh [PDFLAB] [SECONDS_PER_STRATEGY]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+pdflab=${1:-$root/build/release/app/pdflab}
+seconds=${2:-20}
+if [ "${INSIDE_XVFB:-}" != 1 ]; then
+  INSIDE_XVFB=1 exec xvfb-run -a -s "-screen 0 1400x900x24" bash "$0" "$pdflab" "$seconds"
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scene=$work/cornell_400.json
+sed -e 's/"width": 600, "height": 600/"width": 400, "height": 400/' "$root/assets/scenes/cornell_book.json" >"$scene"
+grep -q '"width": 400' "$scene" || { echo "could not resize the scene"; exit 1; }
+echo "reference: nee-mis, 256 spp"
+"$pdflab" render --scene "$scene" --strategy nee-mis --spp 256 --seed 7 --out "$work/ref.pfm" --quiet
+
+start() {  # start STRATEGY: the viewer in the background, its window id in $wid
+  "$pdflab" --scene "$scene" --strategy "$1" --reference "$work/ref.pfm" &
+  viewer=$!
+  wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+  xdotool mousemove 5 5
+}
+stop() { xdotool key --window "$wid" Escape; wait "$viewer"; }
+shot() { import -window "$wid" "$root/docs/$1"; echo "wrote docs/$1"; }
+
+mkdir -p "$root/docs"
+# Convergence: cosine, pinned, then the book's mixture, pinned, then nee-mis (key 4) against both.
+start cosine
+sleep "$seconds"
+xdotool key --window "$wid" k
+xdotool key --window "$wid" 3
+sleep "$seconds"
+xdotool key --window "$wid" k
+xdotool key --window "$wid" g   # the plot off while the views are shown
+xdotool key --window "$wid" v
+sleep 2
+shot view_heatmap.png
+xdotool key --window "$wid" v
+sleep 2
+shot view_difference.png
+xdotool key --window "$wid" v
+xdotool key --window "$wid" v   # back to the image
+xdotool key --window "$wid" g
+xdotool key --window "$wid" 4
+sleep "$seconds"
+sleep 1
+shot convergence_plot.png
+stop
+
+# The nee-mis note is in the panel; the plot and views stay out of the way.
+"$pdflab" --scene "$scene" --strategy nee-mis:balance &
+viewer=$!
+wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+xdotool mousemove 5 5
+sleep 4
+xdotool key --window "$wid" g
+sleep 1
+shot nee_mis_note.png
+stop
+
+# The drop overlay: the tiny-target test scene, whose light pdf overflows.
+"$pdflab" --scene "$root/tests/gui/tiny_target.json" --strategy "mix:cosine=0.5,light=0.5" &
+viewer=$!
+wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+xdotool mousemove 5 5
+sleep 3
+xdotool key --window "$wid" g
+xdotool key --window "$wid" v
+xdotool key --window "$wid" v
+xdotool key --window "$wid" v
+sleep 2
+shot view_drops.png
+stop

@@ -1,0 +1,332 @@
+// The measuring parts of the viewer that need no window: convergence curves
+// and pins, log axes, colour maps and legend values, reference handling, view
+// layers, and nee-mis in the strategy settings.
+#include "renderer/error.h"
+#include "renderer/film/image_io.h"
+#include "renderer/integrator/integrator.h"
+#include "renderer/metrics/metrics.h"
+#include "ui/measure.h"
+#include "ui/settings.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+using namespace pdflab;
+using namespace pdflab::ui;
+
+namespace {
+
+double lightness(const Colour& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+PublishedImage flat_image(int w, int h, float value, std::uint32_t spp = 4) {
+  PublishedImage img;
+  img.info.width = img.info.data_width = w;
+  img.info.height = img.info.data_height = h;
+  img.info.spp = spp;
+  img.info.seconds = 2.0;
+  img.info.estimated_relmse = 0.01;
+  img.info.mean_relative_standard_error = 0.1;
+  img.rgb.assign(3 * static_cast<std::size_t>(w) * h, value);
+  img.relative_standard_error.assign(static_cast<std::size_t>(w) * h, 0.1f);
+  img.drop_mask.assign(static_cast<std::size_t>(w) * h, 0);
+  return img;
+}
+
+}  // namespace
+
+TEST(Convergence, RecordsPassesAndStartsANewCurvePerGeneration) {
+  ConvergenceRecorder rec;
+  EXPECT_TRUE(rec.record(1, "cosine", false, 1, 0.1, 0.5));
+  EXPECT_TRUE(rec.record(1, "cosine", false, 2, 0.2, 0.35));
+  EXPECT_FALSE(rec.record(1, "cosine", false, 2, 0.25, 0.3));  // same spp: no new information
+  EXPECT_FALSE(rec.record(1, "cosine", false, 4, 0.4, 0.0));   // zero error cannot go on a log axis
+  EXPECT_FALSE(rec.record(1, "cosine", false, 4, 0.4, NAN));
+  EXPECT_TRUE(rec.record(1, "cosine", false, 4, 0.4, 0.25));
+  ASSERT_EQ(rec.live().points.size(), 3u);
+  EXPECT_EQ(rec.live().points[2].spp, 4.0);
+  EXPECT_EQ(rec.live().points[2].seconds, 0.4);
+  EXPECT_EQ(rec.live().label, "cosine");
+
+  EXPECT_TRUE(rec.record(2, "nee-mis", false, 1, 0.2, 0.1));  // settings changed
+  EXPECT_EQ(rec.live().points.size(), 1u);
+  EXPECT_EQ(rec.live().label, "nee-mis");
+  // A reference arriving mid-run changes what the errors mean: a new curve too.
+  EXPECT_TRUE(rec.record(2, "nee-mis", true, 2, 0.4, 0.08));
+  EXPECT_EQ(rec.live().points.size(), 1u);
+  EXPECT_TRUE(rec.live().estimated);
+}
+
+TEST(Convergence, ThinsDensePassesToAFewPointsPerDecade) {
+  ConvergenceRecorder rec;
+  int kept = 0;
+  for (std::uint32_t spp = 1; spp <= 10000; ++spp) kept += rec.record(1, "x", false, spp, spp * 0.01, 1.0 / std::sqrt(spp));
+  EXPECT_EQ(static_cast<std::size_t>(kept), rec.live().points.size());
+  EXPECT_LT(kept, 500);
+  EXPECT_GT(kept, 100);
+}
+
+TEST(Convergence, PinKeepsTheCurveUnderItsLabel) {
+  ConvergenceRecorder rec;
+  rec.record(1, "cosine", false, 1, 0.1, 0.5);
+  EXPECT_FALSE(rec.pin());  // one point is no curve
+  rec.record(1, "cosine", false, 2, 0.2, 0.4);
+  EXPECT_TRUE(rec.pin());
+  rec.record(2, "mix:cosine=0.5,light=0.5", false, 1, 0.1, 0.2);
+  ASSERT_EQ(rec.pins().size(), 1u);
+  EXPECT_EQ(rec.pins()[0].label, "cosine");
+  EXPECT_EQ(rec.pins()[0].points.size(), 2u);
+  EXPECT_EQ(rec.live().label, "mix:cosine=0.5,light=0.5");  // the next strategy runs against it
+
+  for (std::size_t i = 0; i < ConvergenceRecorder::kMaxPins + 2; ++i) {
+    rec.record(10 + i, "s" + std::to_string(i), false, 1, 0.1, 0.5);
+    rec.record(10 + i, "s" + std::to_string(i), false, 2, 0.2, 0.4);
+    rec.pin();
+  }
+  EXPECT_EQ(rec.pins().size(), ConvergenceRecorder::kMaxPins);
+  EXPECT_EQ(rec.pins().back().label, "s" + std::to_string(ConvergenceRecorder::kMaxPins + 1));
+  rec.clear_pins();
+  EXPECT_TRUE(rec.pins().empty());
+  EXPECT_EQ(rec.live().points.size(), 2u);  // clearing pins leaves the running curve
+}
+
+TEST(LogAxis, SnapsToDecades) {
+  const LogRange r = log_range({0.03, 0.5, 2.0, -1.0, 0.0, INFINITY});
+  EXPECT_DOUBLE_EQ(r.lo, 0.01);
+  EXPECT_DOUBLE_EQ(r.hi, 10.0);
+  EXPECT_NEAR(r.position(0.1), 1.0 / 3.0, 1e-12);
+  const auto ticks = decade_ticks(r);
+  ASSERT_EQ(ticks.size(), 4u);
+  EXPECT_DOUBLE_EQ(ticks[0], 0.01);
+  EXPECT_DOUBLE_EQ(ticks[3], 10.0);
+  const LogRange one = log_range({1.0});
+  EXPECT_DOUBLE_EQ(one.lo, 1.0);
+  EXPECT_DOUBLE_EQ(one.hi, 10.0);
+  const LogRange none = log_range({});
+  EXPECT_DOUBLE_EQ(none.lo, 1.0);
+  EXPECT_DOUBLE_EQ(none.hi, 10.0);
+}
+
+TEST(ColourMaps, SequentialBrightensMonotonicallyAndDivergingIsPaleAtZero) {
+  double last = -1.0;
+  for (int i = 0; i <= 100; ++i) {
+    const double l = lightness(sequential_colour(i / 100.0));
+    EXPECT_GT(l, last) << i;
+    last = l;
+  }
+  EXPECT_LT(lightness(sequential_colour(0.0)), 0.05);
+  EXPECT_GT(lightness(sequential_colour(1.0)), 0.8);
+  const Colour zero = diverging_colour(0.0);
+  EXPECT_GT(lightness(zero), 0.85);
+  const Colour neg = diverging_colour(-1.0), pos = diverging_colour(1.0);
+  EXPECT_GT(neg[2], neg[0]);  // blue below
+  EXPECT_GT(pos[0], pos[2]);  // red above
+  // Out of range and NaN clamp rather than wrap.
+  EXPECT_EQ(diverging_colour(-5.0), neg);
+  EXPECT_EQ(sequential_colour(NAN), sequential_colour(0.0));
+  // Every drop reason has its own colour, none the "several" white.
+  for (int a = 0; a < kDropReasonCount; ++a) {
+    EXPECT_NE(drop_reason_colour(a), kSeveralDropReasonsColour);
+    for (int b = a + 1; b < kDropReasonCount; ++b) EXPECT_NE(drop_reason_colour(a), drop_reason_colour(b));
+  }
+}
+
+TEST(ColourMaps, HeatMapLegendIsDecadesFromAThousandthToTen) {
+  const ColourScale s = relative_error_scale();
+  const auto ticks = legend_ticks(s);
+  ASSERT_EQ(ticks.size(), 5u);
+  const char* labels[] = {"0.001", "0.01", "0.1", "1", "10"};
+  for (std::size_t i = 0; i < ticks.size(); ++i) {
+    EXPECT_EQ(ticks[i].label, labels[i]);
+    EXPECT_NEAR(ticks[i].position, static_cast<double>(i) / 4.0, 1e-12);
+  }
+  EXPECT_DOUBLE_EQ(s.position(0.1), 0.5);
+  EXPECT_DOUBLE_EQ(s.position(0.0), 0.0);     // a noiseless pixel sits at the bottom
+  EXPECT_DOUBLE_EQ(s.position(1e6), 1.0);
+  EXPECT_EQ(s.colour(10.0), sequential_colour(1.0));
+}
+
+TEST(ColourMaps, DifferenceLegendIsSymmetricAndNice) {
+  EXPECT_DOUBLE_EQ(nice_ceiling(0.031), 0.05);
+  EXPECT_DOUBLE_EQ(nice_ceiling(0.05), 0.05);
+  EXPECT_DOUBLE_EQ(nice_ceiling(0.11), 0.2);
+  EXPECT_DOUBLE_EQ(nice_ceiling(7.0), 10.0);
+  const ColourScale s = difference_scale(0.2);
+  const auto ticks = legend_ticks(s);
+  ASSERT_EQ(ticks.size(), 5u);
+  EXPECT_EQ(ticks[0].label, "-0.2");
+  EXPECT_EQ(ticks[2].label, "0");
+  EXPECT_EQ(ticks[4].label, "+0.2");
+  EXPECT_DOUBLE_EQ(ticks[2].position, 0.5);
+  EXPECT_EQ(s.colour(0.0), diverging_colour(0.0));
+  EXPECT_EQ(s.colour(0.2), diverging_colour(1.0));
+
+  // The 99th percentile sets the range: one firefly in 1000 pixels does not.
+  std::vector<float> d(1000, 0.0f);
+  for (int i = 0; i < 1000; ++i) d[i] = (i % 2 ? 1.0f : -1.0f) * 0.03f * (static_cast<float>(i) / 999.0f);
+  d[17] = 1e6f;
+  EXPECT_DOUBLE_EQ(difference_half_range(d), 0.05);
+  const auto diff = luminance_difference({1, 1, 1, 0, 0, 0}, {0.5f, 0.5f, 0.5f, 0, 0, 1});
+  ASSERT_EQ(diff.size(), 2u);
+  EXPECT_NEAR(diff[0], 0.5f, 1e-6f);
+  EXPECT_NEAR(diff[1], -0.0722f, 1e-6f);
+}
+
+TEST(Reference, SizeMismatchIsSaidAndFiguresFallBackToEstimates) {
+  ReferenceImage ref;
+  ref.path = "ref.pfm";
+  ref.width = 4;
+  ref.height = 2;
+  ref.rgb.assign(24, 0.5f);
+  EXPECT_EQ(reference_size_mismatch(ref, 4, 2), "");
+  EXPECT_EQ(reference_size_mismatch(ReferenceImage{}, 4, 2), "");
+  const std::string m = reference_size_mismatch(ref, 8, 8);
+  EXPECT_NE(m.find("4x2"), std::string::npos) << m;
+  EXPECT_NE(m.find("8x8"), std::string::npos) << m;
+
+  PublishedImage img = flat_image(4, 2, 0.6f);
+  Figures f = compute_figures(img.info, img.rgb, &ref);
+  ASSERT_TRUE(f.valid);
+  EXPECT_TRUE(f.against_reference);
+  EXPECT_NEAR(f.rmse, 0.1, 1e-6);
+  EXPECT_NEAR(f.relmse, relmse(img.rgb, ref.rgb, 1e-2), 1e-12);
+  EXPECT_NEAR(f.relmse, 0.01 / (0.25 + 0.01), 1e-6);  // epsilon 1e-2
+  EXPECT_NEAR(f.efficiency, 1.0 / (f.relmse * 2.0), 1e-9);
+  EXPECT_NEAR(f.plot_error(), std::sqrt(f.relmse), 1e-12);
+
+  const PublishedImage big = flat_image(8, 8, 0.6f);
+  f = compute_figures(big.info, big.rgb, &ref);
+  ASSERT_TRUE(f.valid);
+  EXPECT_FALSE(f.against_reference);
+  EXPECT_DOUBLE_EQ(f.estimated_relmse, 0.01);
+  EXPECT_DOUBLE_EQ(f.estimated_efficiency, 1.0 / (0.01 * 2.0));
+  EXPECT_DOUBLE_EQ(f.plot_error(), 0.1);
+
+  PublishedImage preview = flat_image(4, 2, 0.6f, 0);
+  preview.info.preview = true;
+  EXPECT_FALSE(compute_figures(preview.info, preview.rgb, &ref).valid);
+}
+
+TEST(Reference, LoadsAPfmAndNamesABadOne) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string path = (dir / ("pdflab-measure-ref-" + std::to_string(::getpid()) + ".pfm")).string();
+  const std::vector<float> rgb(3 * 6, 0.25f);
+  const auto bytes = encode_pfm(rgb, 3, 2);
+  write_file_atomic(path, bytes);
+  const ReferenceImage ref = load_reference(path);
+  EXPECT_EQ(ref.width, 3);
+  EXPECT_EQ(ref.height, 2);
+  EXPECT_EQ(ref.path, path);
+  std::filesystem::remove(path);
+  try {
+    load_reference(path);
+    FAIL() << "a missing file must throw";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeasureState, RenderAtReferenceSizeThenMeasures) {
+  // The viewer's flow: a mismatched reference gives estimates only; at the
+  // reference's size the next image is measured against it.
+  MeasureState m;
+  ReferenceImage ref;
+  ref.width = 4;
+  ref.height = 2;
+  ref.rgb.assign(24, 0.5f);
+  m.published = flat_image(8, 8, 0.5f);
+  m.set_reference(ref);
+  EXPECT_FALSE(m.size_mismatch(8, 8).empty());
+  EXPECT_FALSE(m.figures.against_reference);
+  m.published = flat_image(4, 2, 0.55f);
+  m.published.info.generation = 3;
+  m.on_image(3, "cosine");
+  EXPECT_TRUE(m.size_mismatch(4, 2).empty());
+  EXPECT_TRUE(m.figures.against_reference);
+  ASSERT_EQ(m.curves.live().points.size(), 1u);
+  EXPECT_FALSE(m.curves.live().estimated);
+  // An image of an older generation (settings just changed) is not recorded.
+  m.published.info.spp = 8;
+  m.on_image(4, "cosine");
+  EXPECT_EQ(m.curves.live().points.size(), 1u);
+}
+
+TEST(ViewLayer, EachModeSaysWhyWhenItCannotShow) {
+  PublishedImage img = flat_image(4, 2, 0.5f);
+  ViewLayer layer;
+  std::string why;
+  EXPECT_FALSE(build_view_layer(ViewMode::Image, img, nullptr, layer, why));
+  EXPECT_TRUE(build_view_layer(ViewMode::RelativeError, img, nullptr, layer, why));
+  EXPECT_EQ(layer.rgba.size(), 4u * 8u);
+  EXPECT_EQ(layer.rgba[3], 255);
+  why.clear();
+  EXPECT_FALSE(build_view_layer(ViewMode::Difference, img, nullptr, layer, why));
+  EXPECT_NE(why.find("reference"), std::string::npos);
+
+  PublishedImage preview = img;
+  preview.info.preview = true;
+  preview.relative_standard_error.clear();
+  preview.drop_mask.clear();
+  why.clear();
+  EXPECT_FALSE(build_view_layer(ViewMode::Drops, preview, nullptr, layer, why));
+  EXPECT_NE(why.find("full pass"), std::string::npos);
+}
+
+TEST(ViewLayer, DropsAreColouredByReasonAndCounted) {
+  PublishedImage img = flat_image(4, 1, 0.5f);
+  img.drop_mask = {0, 1u << static_cast<int>(DropReason::PdfNotFinite), 1u << static_cast<int>(DropReason::PdfZero),
+                   (1u << static_cast<int>(DropReason::PdfZero)) | (1u << static_cast<int>(DropReason::RadianceNotFinite))};
+  ViewLayer layer;
+  std::string why;
+  ASSERT_TRUE(build_view_layer(ViewMode::Drops, img, nullptr, layer, why));
+  EXPECT_EQ(layer.drop_pixels[static_cast<int>(DropReason::PdfZero)], 1u);
+  EXPECT_EQ(layer.drop_pixels[static_cast<int>(DropReason::PdfNotFinite)], 1u);
+  EXPECT_EQ(layer.drop_pixels[static_cast<int>(DropReason::RadianceNotFinite)], 0u);
+  EXPECT_EQ(layer.drop_pixels[kDropReasonCount], 1u);  // several reasons
+  EXPECT_LT(layer.rgba[3], 255);                       // clean pixel: a translucent dimmer
+  const Colour cyan = drop_reason_colour(static_cast<int>(DropReason::PdfNotFinite));
+  EXPECT_EQ(layer.rgba[4], static_cast<std::uint8_t>(std::lround(cyan[0] * 255.0f)));
+  EXPECT_EQ(layer.rgba[7], 255);
+  EXPECT_EQ(layer.rgba[12], 255);  // white for several
+}
+
+TEST(DropBits, OneBitPerReasonThatGrew) {
+  DropCounts before, after;
+  EXPECT_EQ(drop_reason_bits(before, after), 0);
+  after.add(DropReason::RadianceNotFinite);
+  after.add(DropReason::PdfZero);
+  after.add(DropReason::PdfZero);
+  EXPECT_EQ(drop_reason_bits(before, after),
+            (1u << static_cast<int>(DropReason::PdfZero)) | (1u << static_cast<int>(DropReason::RadianceNotFinite)));
+}
+
+TEST(NeeMisSetting, IsItsOwnModeAndUnbiased) {
+  for (const char* text : {"nee-mis", "nee-mis:balance"}) {
+    const auto s = SamplingSettings::from(Strategy::parse(text));
+    EXPECT_TRUE(s.nee_mis);
+    EXPECT_EQ(s.strategy().to_string(), Strategy::parse(text).to_string());
+    EXPECT_TRUE(s.strategy().is_unbiased()) << text;  // the "unbiased" badge, not "BIASED"
+  }
+  // Leaving nee-mis for a mixture restores a usable mixture, not all-zero weights.
+  auto s = SamplingSettings::from(Strategy::nee(MisHeuristic::Balance));
+  EXPECT_EQ(s.heuristic, MisHeuristic::Balance);
+  s.nee_mis = false;
+  EXPECT_TRUE(s.mixture);
+  EXPECT_GT(s.normalised()[static_cast<int>(Technique::Cosine)], 0.0f);
+  EXPECT_TRUE(s.strategy().is_unbiased());
+  // Biased strategies still say so.
+  EXPECT_FALSE(SamplingSettings::from(Strategy::parse("light-sa")).strategy().is_unbiased());
+}
+
+TEST(NoiseSummary, MatchesTheSeparateMetrics) {
+  Film film(3, 2);
+  for (std::size_t p = 0; p < film.pixel_count(); ++p)
+    for (float s = 0.0f; s < 5.0f; s += 1.0f)
+      film.add(p, Vec3(0.1f * static_cast<float>(p + 1) + 0.05f * s, 0.2f * s, 1.0f / (s + 1.0f)));
+  std::vector<float> map;
+  const NoiseSummary n = noise_summary(film, map);
+  EXPECT_EQ(map, relative_standard_error_map(film));
+  EXPECT_DOUBLE_EQ(n.mean_relative_standard_error, mean_relative_standard_error(film));
+  EXPECT_NEAR(n.estimated_relmse, estimated_relmse(film), 1e-15);
+}

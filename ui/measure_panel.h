@@ -1,0 +1,26 @@
+#pragma once
+// The measuring UI: the Measure section of the side panel, the view-mode
+// selector, the colour bar and drop legend over the image, the convergence
+// plot, and the note on next-event estimation. ImGui only; the numbers come
+// from ui/measure.h.
+#include "ui/settings.h"
+
+#include <cstdint>
+
+namespace pdflab::ui {
+
+// Where the image is drawn, in ImGui coordinates (top-left origin).
+struct ImageRect {
+  float x = 0.0f, y = 0.0f, width = 0.0f, height = 0.0f;
+};
+
+void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests);
+void draw_view_mode_selector(ViewerSettings& settings);
+// "How is this different?": nee-mis against the book's one-sample mixture.
+void draw_nee_explanation();
+// The false-colour layer (texture: ViewTexture::id, 0 for none), its legend,
+// and the convergence plot, over the image area.
+void draw_image_overlays(const ImageRect& image, const ImageRect& area, ViewerSettings& settings,
+                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests);
+
+}  // namespace pdflab::ui
