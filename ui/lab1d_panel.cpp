@@ -1,4 +1,5 @@
 #include "ui/lab1d_panel.h"
+#include "ui/style.h"
 
 #include "renderer/sampling/rng.h"
 #include "ui/teach_draw.h"
@@ -14,9 +15,6 @@ namespace pdflab::ui {
 
 namespace {
 
-const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
-const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
-const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
 constexpr ImU32 kF = IM_COL32(90, 170, 255, 255);
 constexpr ImU32 kP = IM_COL32(255, 190, 60, 255);
 constexpr ImU32 kHist = IM_COL32(255, 190, 60, 110);

@@ -20,7 +20,7 @@ ViewMode next_view_mode(ViewMode mode);
 // The measuring part of ViewerSettings.
 struct MeasureSettings {
   ViewMode view_mode = ViewMode::Image;
-  bool show_plot = true;
+  bool show_plot = false;  // G shows it; off at first so the image is seen whole
   bool plot_against_spp = false;  // false: against rendering seconds
   std::string reference_field;    // the path as typed
 };

@@ -1,4 +1,5 @@
 #include "ui/measure_panel.h"
+#include "ui/style.h"
 
 #include "renderer/integrator/integrator.h"
 #include "renderer/metrics/metrics.h"
@@ -16,9 +17,6 @@ namespace pdflab::ui {
 
 namespace {
 
-const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
-const ImVec4 kAmber{1.0f, 0.78f, 0.3f, 1.0f};
-const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
 
 // Pinned curves take these in turn; the running one is drawn in white on top.
 constexpr ImU32 kPinColours[] = {IM_COL32(90, 170, 255, 255),  IM_COL32(255, 140, 60, 255),

@@ -1,4 +1,5 @@
 #include "ui/panels.h"
+#include "ui/style.h"
 
 #include "renderer/integrator/integrator.h"
 #include "ui/measure_panel.h"
@@ -15,10 +16,6 @@ namespace pdflab::ui {
 
 namespace {
 
-const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
-const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
-const ImVec4 kAmber{1.0f, 0.78f, 0.3f, 1.0f};
-const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
 
 std::string format_seconds(double s) {
   char buf[32];

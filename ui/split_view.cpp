@@ -1,4 +1,5 @@
 #include "ui/split_view.h"
+#include "ui/style.h"
 
 #include "renderer/metrics/metrics.h"
 
@@ -13,9 +14,6 @@ namespace pdflab::ui {
 
 namespace {
 
-const ImVec4 kRed{1.0f, 0.42f, 0.38f, 1.0f};
-const ImVec4 kGreen{0.45f, 0.85f, 0.45f, 1.0f};
-const ImVec4 kDim{0.65f, 0.65f, 0.68f, 1.0f};
 
 void side_box(const char* id, const char* side, const SideFigures& f, ImVec2 pos, ImVec2 pivot) {
   ImGui::SetNextWindowPos(pos, ImGuiCond_Always, pivot);

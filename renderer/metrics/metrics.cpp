@@ -42,44 +42,21 @@ double efficiency(double relmse_value, double seconds) {
   return 1.0 / (relmse_value * seconds);
 }
 
+// The three film-only figures share one pass over the pixels (noise_summary).
 double mean_relative_standard_error(const Film& film, double epsilon) {
-  double sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
-    if (film.count(p) < 2) continue;
-    double m[3], v[3];
-    film.mean(p, m);
-    film.variance_of_mean(p, v);
-    sum += std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
-    ++n;
-  }
-  return n ? sum / static_cast<double>(n) : 0.0;
+  std::vector<float> map;
+  return noise_summary(film, map, epsilon).mean_relative_standard_error;
 }
 
 double estimated_relmse(const Film& film, double epsilon) {
-  double sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
-    if (film.count(p) < 2) continue;
-    double m[3], v[3];
-    film.mean(p, m);
-    film.variance_of_mean(p, v);
-    for (int c = 0; c < 3; ++c) sum += v[c] / (m[c] * m[c] + epsilon);
-    n += 3;
-  }
-  return n ? sum / static_cast<double>(n) : 0.0;
+  std::vector<float> map;
+  return noise_summary(film, map, epsilon).estimated_relmse;
 }
 
 std::vector<float> relative_standard_error_map(const Film& film, double epsilon) {
-  std::vector<float> out(film.pixel_count(), 0.0f);
-  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
-    if (film.count(p) < 2) continue;
-    double m[3], v[3];
-    film.mean(p, m);
-    film.variance_of_mean(p, v);
-    out[p] = static_cast<float>(std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon));
-  }
-  return out;
+  std::vector<float> map;
+  (void)noise_summary(film, map, epsilon);
+  return map;
 }
 
 NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon) {

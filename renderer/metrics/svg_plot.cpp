@@ -29,8 +29,9 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-constexpr const char* kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
-                                    "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
+// Fourteen distinguishable colours: a report compares a dozen strategies on one plot.
+constexpr const char* kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
+                                    "#17becf", "#7f7f7f", "#bcbd22", "#000000", "#6b6ecf", "#e7ba52", "#843c39"};
 
 }  // namespace
 

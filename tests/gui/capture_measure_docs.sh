@@ -35,7 +35,6 @@ xdotool key --window "$wid" k
 xdotool key --window "$wid" 3
 sleep "$seconds"
 xdotool key --window "$wid" k
-xdotool key --window "$wid" g   # the plot off while the views are shown
 xdotool key --window "$wid" v
 sleep 2
 shot view_heatmap.png
@@ -44,7 +43,7 @@ sleep 2
 shot view_difference.png
 xdotool key --window "$wid" v
 xdotool key --window "$wid" v   # back to the image
-xdotool key --window "$wid" g
+xdotool key --window "$wid" g   # the plot on (it starts hidden)
 xdotool key --window "$wid" 4
 sleep "$seconds"
 sleep 1
@@ -56,9 +55,7 @@ stop
 viewer=$!
 wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 xdotool mousemove 5 5
-sleep 4
-xdotool key --window "$wid" g
-sleep 1
+sleep 5
 shot nee_mis_note.png
 stop
 
@@ -68,7 +65,6 @@ viewer=$!
 wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 xdotool mousemove 5 5
 sleep 3
-xdotool key --window "$wid" g
 xdotool key --window "$wid" v
 xdotool key --window "$wid" v
 xdotool key --window "$wid" v

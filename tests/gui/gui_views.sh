@@ -44,7 +44,6 @@ wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 [ -n "$wid" ] || fail "no viewer window"
 xdotool mousemove 5 5
 sleep 3
-xdotool key --window "$wid" g   # hide the plot: it covers part of the image
 sleep 1
 # The image sits centred in the area left of the 400-pixel panel.
 read -r ww wh <<<"$(xdotool getwindowgeometry "$wid" | awk '/Geometry/ { split($2, g, "x"); print g[1], g[2] }')"
