@@ -337,8 +337,10 @@ void draw_nee_explanation() {
       "balance p_a / (p_a + p_b). Every path to a light is counted once in total.");
   ImGui::Spacing();
   ImGui::TextWrapped(
-      "Unbiased: the cosine sample reaches every direction. A bounce costs a shadow ray more; noise from small "
-      "lights falls much faster. It aims at emitters only, not at the glass sphere.");
+      "Unbiased: the cosine sample reaches every direction. Per sample, noise from small lights falls much "
+      "faster; but a bounce costs a shadow ray more and paths no longer end on the light, so per second it "
+      "wins mainly where light comes straight from the lights (compare with the Convergence plot). It aims at "
+      "emitters only, not at the glass sphere.");
   ImGui::PopStyleColor();
   ImGui::TreePop();
 }
