@@ -36,7 +36,6 @@ inline float max_abs_component(const Vec3& a) {
 inline bool is_finite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
-inline float clamp01(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
 
 // sin and cos of 2 pi u for u in [0, 1], to about 3e-7: reduced to [-pi/4, pi/4]
 // around the nearest quarter turn, then short Taylor polynomials, then rotated

@@ -301,6 +301,25 @@ TEST(Extremes, ThinWallAtLargeCoordinatesDoesNotLeakLight) {
   }
 }
 
+TEST(Extremes, IntersectionIsTheSameWithAndWithoutTheSimdBatch) {
+  // A scene edited by hand after prepare() falls back to the scalar loop; both must agree.
+  Scene prepared = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  Scene stale = prepared;
+  stale.quad_batch = QuadBatch{};
+  stale.quad_batch.count = -1;  // never equal to quads.size(): the batch is out of date
+  Rng rng(21, 4);
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 o(rng.uniform() * 555.0f, rng.uniform() * 555.0f, rng.uniform() * 555.0f);
+    const Ray ray{o, sample_uniform_sphere(rng.uniform(), rng.uniform()).direction};
+    Hit a, b;
+    const bool ha = intersect(prepared, ray, kInf, a), hb = intersect(stale, ray, kInf, b);
+    ASSERT_EQ(ha, hb) << i;
+    if (!ha) continue;
+    ASSERT_EQ(a.material, b.material) << i;
+    ASSERT_NEAR(a.t, b.t, 1e-3f * a.t) << i;
+  }
+}
+
 // ---- Shipped scenes never drop a sample ------------------------------------------------
 
 TEST(Extremes, NoShippedSceneDropsASample) {

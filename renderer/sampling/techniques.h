@@ -75,19 +75,6 @@ inline DirectionSample sample_quad_area(const Quad& quad, const Vec3& origin, fl
   return {direction, dist2 / (cosine * quad.area)};
 }
 
-// Distance along a unit ray to the quad, or a negative value when it misses.
-// The tests are combined with `&` into one branch: whether a direction reaches
-// a target is unpredictable, and one mispredicted branch costs more than the math.
-inline float quad_hit_distance(const Quad& quad, const Vec3& origin, const Vec3& direction) {
-  const float denom = dot(quad.normal, direction);
-  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;  // +-inf or NaN when parallel
-  const Vec3 rel = origin + direction * t - quad.q;
-  const float a = dot(rel, quad.alpha_axis);
-  const float b = dot(rel, quad.beta_axis);
-  const bool hit = (t > 0.0f) & (t < kInf) & (a >= 0.0f) & (a <= 1.0f) & (b >= 0.0f) & (b <= 1.0f);
-  return hit ? t : -1.0f;
-}
-
 inline float quad_area_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {
   const float t = quad_hit_distance(quad, origin, direction);
   if (t < 0.0f) return 0.0f;

@@ -42,19 +42,6 @@ Ray Camera::generate_ray(float px, float py) const {
 
 namespace {
 
-inline bool hit_quad(const Quad& quad, const Ray& ray, float t_max, float& t_out) {
-  const float denom = dot(quad.normal, ray.direction);
-  if (std::fabs(denom) < 1e-9f) return false;  // parallel to the plane
-  const float t = (quad.plane_d - dot(quad.normal, ray.origin)) / denom;
-  if (!(t > 0.0f && t < t_max)) return false;
-  const Vec3 rel = ray.origin + ray.direction * t - quad.q;
-  const float a = dot(rel, quad.alpha_axis);
-  const float b = dot(rel, quad.beta_axis);
-  if (a < 0.0f || a > 1.0f || b < 0.0f || b > 1.0f) return false;
-  t_out = t;
-  return true;
-}
-
 inline bool hit_sphere(const Sphere& sphere, const Ray& ray, float t_max, float& t_out) {
   // Distance along the ray to the closest approach, and the squared distance of
   // that point from the centre: stable for far and small spheres, unlike b^2 - 4ac.
@@ -152,8 +139,8 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
   } else {
     const int nq = static_cast<int>(scene.quads.size());
     for (int i = 0; i < nq; ++i) {
-      float t;
-      if (hit_quad(scene.quads[i], ray, closest, t)) {
+      const float t = quad_hit_distance(scene.quads[i], ray.origin, ray.direction);
+      if (t > 0.0f && t < closest) {
         closest = t;
         best_quad = i;
       }

@@ -40,6 +40,19 @@ struct Sphere {
 // Builds a quad with its derived plane data. Throws nothing: callers validate u x v != 0.
 Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material);
 
+// Distance along a unit ray to the quad, or a negative value when it misses.
+// The tests are combined with `&` into one branch: whether a direction reaches
+// a target is unpredictable, and one mispredicted branch costs more than the math.
+inline float quad_hit_distance(const Quad& quad, const Vec3& origin, const Vec3& direction) {
+  const float denom = dot(quad.normal, direction);
+  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;  // +-inf or NaN when parallel
+  const Vec3 rel = origin + direction * t - quad.q;
+  const float a = dot(rel, quad.alpha_axis);
+  const float b = dot(rel, quad.beta_axis);
+  const bool hit = (t > 0.0f) & (t < kInf) & (a >= 0.0f) & (a <= 1.0f) & (b >= 0.0f) & (b <= 1.0f);
+  return hit ? t : -1.0f;
+}
+
 // An object that the `light` techniques aim at (the book's `lights` list).
 struct Target {
   enum class Kind : std::uint8_t { Quad, Sphere } kind;
