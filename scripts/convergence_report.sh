@@ -98,10 +98,9 @@ run_date=$(date -u +%Y-%m-%d)
 } > "$run_info"
 fi
 
-# One markdown table from a bench CSV. The strategy field is quoted (mixtures
-# hold commas); the rest are plain numbers. "vs cosine" is the efficiency ratio.
-table() {
-  awk '
+# An awk function both tables use: one CSV row into f[], the strategy field
+# quoted (mixtures hold commas), the rest plain numbers.
+SPLIT_ROW='
     function split_row(line, f,   rest, n) {
       rest = line
       if (substr(rest, 1, 1) == "\"") {
@@ -113,6 +112,12 @@ table() {
       }
       return split(rest, f, ",")
     }
+'
+
+# One markdown table from a bench CSV. The strategy field is quoted (mixtures
+# hold commas); the rest are plain numbers. "vs cosine" is the efficiency ratio.
+table() {
+  awk "$SPLIT_ROW"'
     NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
     {
       split_row($0, f)
@@ -137,18 +142,7 @@ table() {
 # from the measured relMSE for cosine and for the winner, and the reference's
 # share of the error (from the run of the reference's own strategy).
 summary() {
-  awk -v ref_spp="$2" -v ref_strategy="$REF_STRATEGY" '
-    function split_row(line, f,   rest, n) {
-      rest = line
-      if (substr(rest, 1, 1) == "\"") {
-        f[1] = substr(rest, 2, index(substr(rest, 2), "\"") - 1)
-        rest = substr(rest, length(f[1]) + 4)
-        n = split(rest, tail, ",")
-        for (i = 1; i <= n; ++i) f[i + 1] = tail[i]
-        return n + 1
-      }
-      return split(rest, f, ",")
-    }
+  awk -v ref_spp="$2" -v ref_strategy="$REF_STRATEGY" "$SPLIT_ROW"'
     NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
     {
       split_row($0, f)

@@ -137,4 +137,29 @@ inline std::vector<std::string> listing(const std::filesystem::path& root) {
   return names;
 }
 
+// A test's own place to run the binary: an empty working folder (the child's
+// cwd, where its outputs go) and a separate folder for the captured streams,
+// so that "nothing was written" is a listing of the working folder.
+class CommandWorkspace {
+ public:
+  explicit CommandWorkspace(const std::string& prefix) : root_(prefix) {
+    std::filesystem::create_directory(work());
+    std::filesystem::create_directory(root_.path() / "io");
+  }
+  std::filesystem::path work() const { return root_.path() / "work"; }
+  std::string in_work(const std::string& name) const { return (work() / name).string(); }
+  std::vector<std::string> work_entries() const { return listing(work()); }
+  // The binary itself (no shell), stdin from /dev/null, in the working folder.
+  ChildResult run(const std::vector<std::string>& args, double deadline_seconds = 120.0) const {
+    ChildOptions o;
+    o.cwd = work();
+    o.capture = root_.path() / "io";
+    o.deadline_seconds = deadline_seconds;
+    return run_pdflab(args, o);
+  }
+
+ private:
+  TempDir root_;
+};
+
 }  // namespace pdflab::testing

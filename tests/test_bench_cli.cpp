@@ -135,25 +135,15 @@ std::vector<std::map<std::string, std::string>> parse_csv(const std::string& tex
 
 class BenchCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    fs::create_directory(work());
-    fs::create_directory(root_.path() / "io");
-  }
-
-  fs::path work() const { return root_.path() / "work"; }
-  std::string in_work(const std::string& name) const { return (work() / name).string(); }
-  std::vector<std::string> work_entries() const { return pdflab::testing::listing(work()); }
-
-  // The binary itself (no shell), stdin from /dev/null, in the work folder.
+  fs::path work() const { return ws_.work(); }
+  std::string in_work(const std::string& name) const { return ws_.in_work(name); }
+  std::vector<std::string> work_entries() const { return ws_.work_entries(); }
   ChildResult run(const std::vector<std::string>& args) const {
-    pdflab::testing::ChildOptions o;
-    o.cwd = work();
-    o.capture = root_.path() / "io";
-    o.deadline_seconds = 120.0;
-    const ChildResult r = pdflab::testing::run_pdflab(args, o);
+    const ChildResult r = ws_.run(args);
     if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
     return r;
   }
+
 
   // A non-square reference, so a swapped width and height would show.
   void make_reference(const std::string& name = "ref.pfm") const {
@@ -182,7 +172,7 @@ class BenchCommand : public ::testing::Test {
   }
 
  private:
-  pdflab::testing::TempDir root_{"pdflab-bench"};
+  pdflab::testing::CommandWorkspace ws_{"pdflab-bench"};
 };
 
 TEST_F(BenchCommand, MissingReferenceIsBadInput) {

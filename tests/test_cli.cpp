@@ -36,25 +36,15 @@ using testing::slurp;
 // written" can be checked by listing the working folder.
 class RenderCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    fs::create_directory(work());
-    fs::create_directory(root_.path() / "io");
-  }
-
-  fs::path work() const { return root_.path() / "work"; }
-  std::string in_work(const std::string& name) const { return (work() / name).string(); }
-  std::vector<std::string> work_entries() const { return testing::listing(work()); }
-
-  // Runs the binary directly (no shell) with stdin from /dev/null.
+  fs::path work() const { return ws_.work(); }
+  std::string in_work(const std::string& name) const { return ws_.in_work(name); }
+  std::vector<std::string> work_entries() const { return ws_.work_entries(); }
   ChildResult run(const std::vector<std::string>& args) const {
-    testing::ChildOptions o;
-    o.cwd = work();
-    o.capture = root_.path() / "io";
-    o.deadline_seconds = 120.0;
-    const ChildResult r = testing::run_pdflab(args, o);
+    const ChildResult r = ws_.run(args);
     if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
     return r;
   }
+
 
   // A render command line that is valid except for what `overrides` changes.
   std::vector<std::string> render_args(std::initializer_list<std::string> extra = {}) const {
@@ -94,7 +84,7 @@ class RenderCommand : public ::testing::Test {
     EXPECT_TRUE(work_entries().empty()) << "files were written: " << ::testing::PrintToString(work_entries());
   }
 
-  testing::TempDir root_{"pdflab-cli"};
+  testing::CommandWorkspace ws_{"pdflab-cli"};
 };
 
 TEST_F(RenderCommand, ValidBaseCommandSucceeds) {
