@@ -5,21 +5,12 @@
 # other missing tool is a failure, so a broken setup cannot pass as "skipped".
 set -euo pipefail
 
-if [ "${1:-}" != "--inside" ]; then
-  if ! command -v xvfb-run >/dev/null 2>&1; then
-    echo "SKIP: xvfb-run is not installed (Debian: apt-get install xvfb xauth)"
-    exit 77
-  fi
-  for tool in xdotool import identify; do
-    command -v "$tool" >/dev/null 2>&1 || { echo "FAIL: $tool is missing (xdotool, imagemagick)"; exit 1; }
-  done
-  exec xvfb-run -a -s "-screen 0 1280x800x24" bash "$0" --inside "$@"
-fi
+source "$(dirname "$0")/lib.sh"
+inside_xvfb "1280x800x24" "xdotool import identify" "$0" "$@"
 shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art/shots"
-fail() { echo "FAIL: $*"; exit 1; }
 
 # png_stats FILE -> "width height mean stddev" (mean and stddev in 0..1)
 png_stats() { identify -format "%w %h %[fx:mean] %[fx:standard_deviation]" "$1"; }

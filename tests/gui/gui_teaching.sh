@@ -9,21 +9,12 @@
 # Exit 77 only when xvfb-run itself is missing.
 set -euo pipefail
 
-if [ "${1:-}" != "--inside" ]; then
-  if ! command -v xvfb-run >/dev/null 2>&1; then
-    echo "SKIP: xvfb-run is not installed (Debian: apt-get install xvfb xauth)"
-    exit 77
-  fi
-  for tool in xdotool import identify compare; do
-    command -v "$tool" >/dev/null 2>&1 || { echo "FAIL: $tool is missing (xdotool, imagemagick)"; exit 1; }
-  done
-  exec xvfb-run -a -s "-screen 0 1400x900x24" bash "$0" --inside "$@"
-fi
+source "$(dirname "$0")/lib.sh"
+inside_xvfb "1400x900x24" "xdotool import identify compare" "$0" "$@"
 shift
 pdflab=$1 scene=$2 art=$3 docs=${4:-}
 rm -rf "$art"
 mkdir -p "$art"
-fail() { echo "FAIL: $*"; exit 1; }
 settle=2
 [ -n "$docs" ] && settle=12
 

@@ -6,21 +6,12 @@
 # Exit 77 only when xvfb-run is missing (see gui_smoke.sh).
 set -euo pipefail
 
-if [ "${1:-}" != "--inside" ]; then
-  if ! command -v xvfb-run >/dev/null 2>&1; then
-    echo "SKIP: xvfb-run is not installed (Debian: apt-get install xvfb xauth)"
-    exit 77
-  fi
-  for tool in xdotool import identify compare convert; do
-    command -v "$tool" >/dev/null 2>&1 || { echo "FAIL: $tool is missing (xdotool, imagemagick)"; exit 1; }
-  done
-  exec xvfb-run -a -s "-screen 0 1280x800x24" bash "$0" --inside "$@"
-fi
+source "$(dirname "$0")/lib.sh"
+inside_xvfb "1280x800x24" "xdotool import identify compare convert" "$0" "$@"
 shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
-fail() { echo "FAIL: $*"; exit 1; }
 stddev() { identify -format "%[fx:standard_deviation]" "$1"; }
 # Normalised RMSE between two images of the same size, 0..1.
 difference() { { compare -metric RMSE "$1" "$2" null: 2>&1 || true; } | sed -E 's/.*\((.*)\).*/\1/'; }
