@@ -338,7 +338,8 @@ void draw_nee_explanation() {
   ImGui::Spacing();
   ImGui::TextWrapped(
       "Unbiased: the cosine sample reaches every direction. Per sample, noise from small lights falls much "
-      "faster; but a bounce costs a shadow ray more and paths no longer end on the light, so per second it "
+      "faster; but a bounce costs a shadow ray more and paths, continued by cosine sampling alone, rarely end "
+      "on a light, so per second it "
       "wins mainly where light comes straight from the lights (compare with the Convergence plot). It aims at "
       "emitters only, not at the glass sphere.");
   ImGui::PopStyleColor();
