@@ -42,8 +42,7 @@ inline float mis_weight(float a, float b, MisHeuristic h) {
   return a / (a + b);
 }
 
-// Follows a metal or dielectric bounce; returns false when the path ends.
-inline bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
+bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
                              Vec3& throughput, Rng& rng) {
   if (m.type == MaterialType::Metal) {
     Vec3 dir = reflect(ray.direction, normal);
@@ -211,8 +210,7 @@ inline std::uint32_t sobol_dim2(std::uint32_t index) {
 
 }  // namespace
 
-Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,
-                         std::uint32_t sample_index, DropCounts& drops) {
+PixelSampleStart begin_pixel_sample(const Scene& scene, std::uint64_t seed, int x, int y, std::uint32_t sample_index) {
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(scene.camera.width) +
                               static_cast<std::uint64_t>(x);
   // A random digital shift per pixel keeps the (0,2)-sequence's stratification
@@ -222,10 +220,14 @@ Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint
   const std::uint32_t sy = sobol_dim2(sample_index) ^ static_cast<std::uint32_t>(scramble >> 32);
   const float jx = static_cast<float>(sx >> 8) * 0x1.0p-24f;
   const float jy = static_cast<float>(sy >> 8) * 0x1.0p-24f;
+  return {scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
+          Rng::for_sample(seed, pixel, sample_index)};
+}
 
-  Rng rng = Rng::for_sample(seed, pixel, sample_index);
-  const Ray ray = scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy);
-  return trace_path(scene, plan, ray, rng, drops);
+Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,
+                         std::uint32_t sample_index, DropCounts& drops) {
+  PixelSampleStart start = begin_pixel_sample(scene, seed, x, y, sample_index);
+  return trace_path(scene, plan, start.ray, start.rng, drops);
 }
 
 }  // namespace pdflab

@@ -48,6 +48,18 @@ inline std::uint8_t drop_reason_bits(const DropCounts& before, const DropCounts&
 // Radiance along one camera ray. Returns zero (and counts) when the estimate is not finite.
 Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops);
 
+// Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
+// ray); returns false when the path ends (absorbed).
+bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
+                      Vec3& throughput, Rng& rng);
+
+// The camera ray and the random stream of one pixel sample.
+struct PixelSampleStart {
+  Ray ray;
+  Rng rng;
+};
+PixelSampleStart begin_pixel_sample(const Scene& scene, std::uint64_t seed, int x, int y, std::uint32_t sample_index);
+
 // One pixel sample: position within the pixel from a scrambled (0,2)-sequence
 // (stratified at every power of two), then the path.
 Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,

@@ -18,6 +18,7 @@ constexpr std::uint64_t mix64(std::uint64_t x) {
 class Rng {
  public:
   Rng(std::uint64_t state, std::uint64_t stream) : pcg_(state, stream) {}
+  Rng() : Rng(0, 0) {}  // a placeholder until a stream is assigned
 
   // The stream for one pixel sample.
   static Rng for_sample(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {

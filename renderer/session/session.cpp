@@ -1,5 +1,6 @@
 #include "renderer/session/session.h"
 
+#include "renderer/integrator/packet.h"
 #include "renderer/metrics/metrics.h"
 
 #include <algorithm>
@@ -251,6 +252,30 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
   const int x1 = std::min(x0 + kTile, scene.camera.width);
   const int y1 = std::min(y0 + kTile, scene.camera.height);
   const std::uint64_t seed = settings_.seed;
+  if (packet_supports(plan_)) {
+    // Eight paths at a time; the samples come back in order and are added to
+    // the film in the same order as below, so the sums are the same bits.
+    const SampleBlock block{x0, y0, x1, y1, pass.first_sample, pass.spp};
+    thread_local std::vector<SampleResult> results;
+    results.resize(block.size());
+    trace_block(scene, plan_, seed, block, results.data());
+    const SampleResult* r = results.data();
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +
+                                  static_cast<std::size_t>(x);
+        std::uint8_t dropped = 0;
+        for (std::uint32_t s = 0; s < pass.spp; ++s, ++r) {
+          film_.add(pixel, r->radiance);
+          dropped |= r->drops;
+          for (int reason = 0; reason < kDropReasonCount; ++reason)
+            if (r->drops & (1u << reason)) drops.add(static_cast<DropReason>(reason));
+        }
+        if (dropped) film_.mark_drops(pixel, dropped);
+      }
+    }
+    return;
+  }
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {
       const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +

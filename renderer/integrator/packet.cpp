@@ -1,0 +1,81 @@
+#include "renderer/integrator/packet.h"
+
+#include <array>
+#include <cstring>
+#include <numbers>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define PDFLAB_PACKET_X86 1
+#else
+#define PDFLAB_PACKET_X86 0
+#endif
+
+// With GCC on x86-64 the kernel is compiled a second time for AVX2 (eight
+// lanes in one register), chosen at run time, so a portable build still uses
+// the machine it runs on. The arithmetic is the same IEEE operations in the
+// same order either way (no FMA contraction in ISO C++ mode), so both give the
+// same bits. Helpers from other headers are compiled for the baseline and may
+// be inlined into the AVX2 code, never the other way round.
+#if PDFLAB_PACKET_X86 && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
+#define PDFLAB_PACKET_DISPATCH 1
+#else
+#define PDFLAB_PACKET_DISPATCH 0
+#endif
+
+// Vectors of eight floats are passed between the kernel's inline helpers only;
+// the note that their ABI differs without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace pdflab {
+
+namespace packet_generic {
+#define PDFLAB_PACKET_AVX2 0
+#include "renderer/integrator/packet_kernel.inc"
+#undef PDFLAB_PACKET_AVX2
+}  // namespace packet_generic
+
+#if PDFLAB_PACKET_DISPATCH
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace packet_avx2 {
+#define PDFLAB_PACKET_AVX2 1
+#include "renderer/integrator/packet_kernel.inc"
+#undef PDFLAB_PACKET_AVX2
+}  // namespace packet_avx2
+#pragma GCC pop_options
+#endif
+
+bool packet_supports(const SamplingPlan& plan) { return !plan.nee_mis; }
+
+PacketIsa best_packet_isa() {
+#if PDFLAB_PACKET_DISPATCH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2 ? PacketIsa::Avx2 : PacketIsa::Generic;
+#elif defined(__AVX2__)
+  return PacketIsa::Avx2;  // the baseline build already targets it
+#else
+  return PacketIsa::Generic;
+#endif
+}
+
+void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
+                 const SampleBlock& block, SampleResult* out) {
+#if PDFLAB_PACKET_DISPATCH
+  if (isa == PacketIsa::Avx2) {
+    packet_avx2::trace_block_impl(scene, plan, seed, block, out);
+    return;
+  }
+#else
+  (void)isa;
+#endif
+  packet_generic::trace_block_impl(scene, plan, seed, block, out);
+}
+
+void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
+                 SampleResult* out) {
+  trace_block(best_packet_isa(), scene, plan, seed, block, out);
+}
+
+}  // namespace pdflab
+

@@ -1,0 +1,50 @@
+#pragma once
+// The book's estimator for eight paths at once. Each SIMD lane carries one
+// path; a lane whose path ends takes the next pixel sample at once, so the
+// lanes stay full. Intersection (every primitive against eight rays) and the
+// diffuse bounce's sampling and mixture pdf run in SIMD; the rest (materials
+// other than lambertian, emission, light-sa's set-up) runs per lane with the
+// scalar code.
+//
+// Every operation mirrors trace_path's, in the same order and precision, and
+// a sample's random numbers come from its own stream as before, so a sample's
+// radiance is the same, bit for bit, as render_pixel_sample's (up to which of
+// two primitives at exactly the same distance counts as hit). The result
+// depends only on (seed, pixel, sample): it is identical for any thread count.
+#include "renderer/integrator/integrator.h"
+
+#include <cstdint>
+
+namespace pdflab {
+
+// The samples first_sample .. first_sample + spp - 1 of every pixel in
+// [x0, x1) x [y0, y1).
+struct SampleBlock {
+  int x0, y0, x1, y1;
+  std::uint32_t first_sample, spp;
+  std::size_t size() const {
+    return static_cast<std::size_t>(x1 - x0) * static_cast<std::size_t>(y1 - y0) * spp;
+  }
+};
+
+struct SampleResult {
+  Vec3 radiance;
+  std::uint8_t drops;  // bit r: the sample was dropped for DropReason r
+};
+
+// Whether trace_block can render this plan (nee-mis is traced one path at a time).
+bool packet_supports(const SamplingPlan& plan);
+
+enum class PacketIsa : std::uint8_t { Generic, Avx2 };
+// The widest instruction set trace_block uses on this machine.
+PacketIsa best_packet_isa();
+
+// Renders every sample of the block; out[(pixel row-major within the block) * spp + k]
+// receives sample first_sample + k. The plan must be supported.
+void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
+                 SampleResult* out);
+// The same with a given instruction set (tests compare them); it must be available.
+void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
+                 const SampleBlock& block, SampleResult* out);
+
+}  // namespace pdflab
