@@ -41,25 +41,6 @@ void Film::clear() {
   std::fill(drop_mask_.begin(), drop_mask_.end(), std::uint8_t{0});
 }
 
-void Film::mean(std::size_t pixel, double out[3]) const {
-  const std::uint32_t n = count_[pixel];
-  const double inv = n > 0 ? 1.0 / n : 0.0;
-  for (int c = 0; c < 3; ++c) out[c] = sum_[3 * pixel + c] * inv;
-}
-
-void Film::variance_of_mean(std::size_t pixel, double out[3]) const {
-  const std::uint32_t n = count_[pixel];
-  for (int c = 0; c < 3; ++c) {
-    if (n < 2) {
-      out[c] = 0.0;
-      continue;
-    }
-    const double m = sum_[3 * pixel + c] / n;
-    const double var = std::max(0.0, (sum_sq_[3 * pixel + c] / n - m * m)) * n / (n - 1.0);
-    out[c] = var / n;
-  }
-}
-
 std::vector<float> Film::mean_rgb() const {
   std::vector<float> out;
   mean_rgb(out);

@@ -48,9 +48,27 @@ class Film {
 
   std::uint32_t count(std::size_t pixel) const { return count_[pixel]; }
   // Mean radiance per channel (zero where no sample landed yet).
-  void mean(std::size_t pixel, double out[3]) const;
+  void mean(std::size_t pixel, double out[3]) const {
+    const std::uint32_t n = count_[pixel];
+    const double inv = n > 0 ? 1.0 / n : 0.0;
+    for (int c = 0; c < 3; ++c) out[c] = sum_[3 * pixel + c] * inv;
+  }
   // Variance of the mean per channel: (E[x^2] - E[x]^2) / (n - 1); zero for n < 2.
-  void variance_of_mean(std::size_t pixel, double out[3]) const;
+  // Inline, with two divisions per pixel: the session computes it for every
+  // pixel after every pass.
+  void variance_of_mean(std::size_t pixel, double out[3]) const {
+    const std::uint32_t n = count_[pixel];
+    if (n < 2) {
+      out[0] = out[1] = out[2] = 0.0;
+      return;
+    }
+    const double inv = 1.0 / n, inv_dof = 1.0 / (n - 1.0);
+    for (int c = 0; c < 3; ++c) {
+      const double m = sum_[3 * pixel + c] * inv;
+      const double excess = sum_sq_[3 * pixel + c] * inv - m * m;
+      out[c] = (excess > 0.0 ? excess : 0.0) * inv_dof;
+    }
+  }
 
   // The mean image as float RGB, row 0 at the top.
   std::vector<float> mean_rgb() const;

@@ -36,10 +36,6 @@ void Camera::prepare() {
   pixel00 = upper_left;  // relative to lookfrom; pixel (x, y) spans [x, x+1) x [y, y+1)
 }
 
-Ray Camera::generate_ray(float px, float py) const {
-  return Ray{lookfrom, normalize(pixel00 + du * px + dv * py)};
-}
-
 namespace {
 
 inline bool hit_sphere(const Sphere& sphere, const Ray& ray, float t_max, float& t_out) {
@@ -171,16 +167,6 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     return true;
   }
   return false;
-}
-
-Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
-  // About 8 float ulps of the largest coordinate (2^-20 relative): the hit
-  // point's rounding error is a few ulps (tests/test_extremes.cpp shows rays
-  // re-hitting their own surface at 1e5 with no offset), plus an absolute floor
-  // for points near the origin. Small enough not to skip walls 0.25 units thick at 1e5.
-  const float offset = 1e-4f + 1e-6f * max_abs_component(point);
-  const float side = dot(direction, geometric_normal) >= 0.0f ? offset : -offset;
-  return Ray{point + geometric_normal * side, direction};
 }
 
 }  // namespace pdflab

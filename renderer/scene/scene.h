@@ -71,7 +71,8 @@ struct Camera {
   // pixel00 + (x + dx) * du + (y + dy) * dv (then normalised).
   Vec3 pixel00, du, dv;
   void prepare();
-  Ray generate_ray(float px, float py) const;  // px, py in pixel units from the top-left corner
+  // px, py in pixel units from the top-left corner
+  Ray generate_ray(float px, float py) const { return Ray{lookfrom, normalize(pixel00 + du * px + dv * py)}; }
 };
 
 // The quads again as structure-of-arrays, padded to a multiple of kQuadLanes
@@ -122,6 +123,14 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit);
 // A new ray leaving `point` in `direction`, moved off the surface along the
 // normal on the side the direction goes, by an offset that scales with the
 // coordinates' magnitude (float spacing grows with it).
-Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction);
+inline Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
+  // About 8 float ulps of the largest coordinate (2^-20 relative): the hit
+  // point's rounding error is a few ulps (tests/test_extremes.cpp shows rays
+  // re-hitting their own surface at 1e5 with no offset), plus an absolute floor
+  // for points near the origin. Small enough not to skip walls 0.25 units thick at 1e5.
+  const float offset = 1e-4f + 1e-6f * max_abs_component(point);
+  const float side = dot(direction, geometric_normal) >= 0.0f ? offset : -offset;
+  return Ray{point + geometric_normal * side, direction};
+}
 
 }  // namespace pdflab
