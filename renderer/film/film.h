@@ -49,24 +49,29 @@ class Film {
   std::uint32_t count(std::size_t pixel) const { return count_[pixel]; }
   // Mean radiance per channel (zero where no sample landed yet).
   void mean(std::size_t pixel, double out[3]) const {
-    const std::uint32_t n = count_[pixel];
-    const double inv = n > 0 ? 1.0 / n : 0.0;
-    for (int c = 0; c < 3; ++c) out[c] = sum_[3 * pixel + c] * inv;
+    double unused[3];
+    moments(pixel, reciprocals(count_[pixel]), out, unused);
   }
   // Variance of the mean per channel: (E[x^2] - E[x]^2) / (n - 1); zero for n < 2.
-  // Inline, with two divisions per pixel: the session computes it for every
-  // pixel after every pass.
   void variance_of_mean(std::size_t pixel, double out[3]) const {
-    const std::uint32_t n = count_[pixel];
-    if (n < 2) {
-      out[0] = out[1] = out[2] = 0.0;
-      return;
-    }
-    const double inv = 1.0 / n, inv_dof = 1.0 / (n - 1.0);
+    double unused[3];
+    moments(pixel, reciprocals(count_[pixel]), unused, out);
+  }
+  // Both at once, with 1/n and 1/(n - 1) given: a sweep over the film (the
+  // session makes one after every pass) computes them once for the many
+  // pixels that share a count.
+  struct Reciprocals {
+    double inv_n = 0.0, inv_dof = 0.0;  // 1/n (0 for n = 0), 1/(n - 1) (0 for n < 2)
+  };
+  static Reciprocals reciprocals(std::uint32_t n) {
+    return {n > 0 ? 1.0 / n : 0.0, n > 1 ? 1.0 / (n - 1.0) : 0.0};
+  }
+  void moments(std::size_t pixel, const Reciprocals& r, double mean_out[3], double variance_of_mean_out[3]) const {
     for (int c = 0; c < 3; ++c) {
-      const double m = sum_[3 * pixel + c] * inv;
-      const double excess = sum_sq_[3 * pixel + c] * inv - m * m;
-      out[c] = (excess > 0.0 ? excess : 0.0) * inv_dof;
+      const double m = sum_[3 * pixel + c] * r.inv_n;
+      const double excess = sum_sq_[3 * pixel + c] * r.inv_n - m * m;
+      mean_out[c] = m;
+      variance_of_mean_out[c] = (excess > 0.0 ? excess : 0.0) * r.inv_dof;
     }
   }
 

@@ -59,15 +59,21 @@ std::vector<float> relative_standard_error_map(const Film& film, double epsilon)
   return map;
 }
 
-NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon) {
-  map.assign(film.pixel_count(), 0.0f);
+NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon, std::vector<float>* mean_rgb) {
+  const std::size_t pixels = film.pixel_count();
+  map.assign(pixels, 0.0f);
+  if (mean_rgb) mean_rgb->resize(3 * pixels);
   double rse_sum = 0.0, rel_sum = 0.0;
   std::size_t n = 0;
-  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
-    if (film.count(p) < 2) continue;
+  std::uint32_t count = 0;  // after a full pass every pixel has the same count
+  Film::Reciprocals r = Film::reciprocals(count);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    if (film.count(p) != count) r = Film::reciprocals(count = film.count(p));
     double m[3], v[3];
-    film.mean(p, m);
-    film.variance_of_mean(p, v);
+    film.moments(p, r, m, v);
+    if (mean_rgb)
+      for (int c = 0; c < 3; ++c) (*mean_rgb)[3 * p + c] = static_cast<float>(m[c]);
+    if (count < 2) continue;
     const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
     map[p] = static_cast<float>(rse);
     rse_sum += rse;

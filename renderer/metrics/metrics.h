@@ -45,6 +45,8 @@ struct NoiseSummary {
   double mean_relative_standard_error = 0.0;
   double estimated_relmse = 0.0;
 };
-NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon = kRelMseEpsilon);
+// With `mean_rgb`, the same sweep also writes the mean image (Film::mean_rgb's values).
+NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon = kRelMseEpsilon,
+                           std::vector<float>* mean_rgb = nullptr);
 
 }  // namespace pdflab

@@ -156,11 +156,11 @@ void RenderSession::finish_pass_locked() {
   samples_done_ += pass_samples;
   if (pass_ms > 1.0) full_samples_per_second_ = static_cast<double>(pass_samples) / (pass_ms * 1e-3);
 
+  // One sweep over the film per pass for the image and its noise (a few ms at
+  // 600x600 against passes of 30-120 ms), so a viewer shows noise without ever
+  // touching the film.
   std::vector<float> rgb;
-  film_.mean_rgb(rgb);
-  // One sweep over the film per pass (a few ms at 600x600 against passes of
-  // 30-120 ms), so a viewer shows noise without ever touching the film.
-  noise_ = noise_summary(film_, spare_rse_);
+  noise_ = noise_summary(film_, spare_rse_, kRelMseEpsilon, &rgb);
   spare_drops_ = film_.drop_masks();
   publish_locked(rgb, pass_);
 
