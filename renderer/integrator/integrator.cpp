@@ -204,29 +204,33 @@ inline std::uint32_t reverse_bits(std::uint32_t v) {
 inline std::uint32_t sobol_dim2(std::uint32_t index) {
   std::uint32_t result = 0;
   for (std::uint32_t v = 1u << 31; index; index >>= 1, v ^= v >> 1)
-    if (index & 1u) result ^= v;
+    result ^= v & (0u - (index & 1u));  // no branch on the bit
   return result;
 }
 
 }  // namespace
 
-PixelSampleStart begin_pixel_sample(const Scene& scene, std::uint64_t seed, int x, int y, std::uint32_t sample_index) {
+SampleSeed::SampleSeed(std::uint64_t seed_value)
+    : seed(seed_value), rng_key(Rng::seed_key(seed_value)), scramble_key(mix64(seed_value ^ 0x5bd1e995u)) {}
+
+PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, int x, int y,
+                                    std::uint32_t sample_index) {
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(scene.camera.width) +
                               static_cast<std::uint64_t>(x);
   // A random digital shift per pixel keeps the (0,2)-sequence's stratification
   // and decorrelates neighbouring pixels.
-  const std::uint64_t scramble = mix64(mix64(seed ^ 0x5bd1e995u) + pixel);
+  const std::uint64_t scramble = mix64(seed.scramble_key + pixel);
   const std::uint32_t sx = reverse_bits(sample_index) ^ static_cast<std::uint32_t>(scramble);
   const std::uint32_t sy = sobol_dim2(sample_index) ^ static_cast<std::uint32_t>(scramble >> 32);
   const float jx = static_cast<float>(sx >> 8) * 0x1.0p-24f;
   const float jy = static_cast<float>(sy >> 8) * 0x1.0p-24f;
   return {scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
-          Rng::for_sample(seed, pixel, sample_index)};
+          Rng::for_sample_keyed(seed.rng_key, pixel, sample_index)};
 }
 
 Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,
                          std::uint32_t sample_index, DropCounts& drops) {
-  PixelSampleStart start = begin_pixel_sample(scene, seed, x, y, sample_index);
+  PixelSampleStart start = begin_pixel_sample(scene, SampleSeed(seed), x, y, sample_index);
   return trace_path(scene, plan, start.ray, start.rng, drops);
 }
 

@@ -58,7 +58,13 @@ struct PixelSampleStart {
   Ray ray;
   Rng rng;
 };
-PixelSampleStart begin_pixel_sample(const Scene& scene, std::uint64_t seed, int x, int y, std::uint32_t sample_index);
+// The seed's share of every sample's stream and scramble, computed once.
+struct SampleSeed {
+  explicit SampleSeed(std::uint64_t seed);
+  std::uint64_t seed, rng_key, scramble_key;
+};
+PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, int x, int y,
+                                    std::uint32_t sample_index);
 
 // One pixel sample: position within the pixel from a scrambled (0,2)-sequence
 // (stratified at every power of two), then the path.

@@ -22,7 +22,12 @@ class Rng {
 
   // The stream for one pixel sample.
   static Rng for_sample(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {
-    const std::uint64_t key = mix64(mix64(seed) ^ (pixel * 0x9e3779b97f4a7c15ULL + sample));
+    return for_sample_keyed(seed_key(seed), pixel, sample);
+  }
+  // The same with the seed's part computed once for many samples.
+  static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed); }
+  static Rng for_sample_keyed(std::uint64_t seed_key, std::uint64_t pixel, std::uint64_t sample) {
+    const std::uint64_t key = mix64(seed_key ^ (pixel * 0x9e3779b97f4a7c15ULL + sample));
     return Rng(key, mix64(key ^ 0x632be59bd9b4e019ULL));
   }
 
