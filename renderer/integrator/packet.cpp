@@ -1,6 +1,8 @@
 #include "renderer/integrator/packet.h"
 
 #include <array>
+#include <cstdlib>
+#include <string_view>
 #include <cstring>
 #include <numbers>
 
@@ -12,7 +14,7 @@
 #endif
 
 // With GCC on x86-64 the kernel is compiled a second time for AVX2 (eight
-// lanes in one register), chosen at run time, so a portable build still uses
+// lanes in one register, against four with SSE2), chosen at run time, so a portable build still uses
 // the machine it runs on. The arithmetic is the same IEEE operations in the
 // same order either way (no FMA contraction in ISO C++ mode), so both give the
 // same bits. Helpers from other headers are compiled for the baseline and may
@@ -49,14 +51,30 @@ namespace packet_avx2 {
 bool packet_supports(const SamplingPlan& plan) { return !plan.nee_mis; }
 
 PacketIsa best_packet_isa() {
+  // PDFLAB_ISA=generic keeps the baseline code (to compare, or to rule the wider code out).
+  static const PacketIsa isa = [] {
+    const char* requested = std::getenv("PDFLAB_ISA");
+    if (requested && std::string_view(requested) == "generic") return PacketIsa::Generic;
 #if PDFLAB_PACKET_DISPATCH
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2 ? PacketIsa::Avx2 : PacketIsa::Generic;
+    return __builtin_cpu_supports("avx2") ? PacketIsa::Avx2 : PacketIsa::Generic;
 #elif defined(__AVX2__)
-  return PacketIsa::Avx2;  // the baseline build already targets it
+    return PacketIsa::Avx2;  // the baseline build already targets it
 #else
-  return PacketIsa::Generic;
+    return PacketIsa::Generic;
 #endif
+  }();
+  return isa;
+}
+
+std::string_view packet_isa_name(PacketIsa isa) { return isa == PacketIsa::Avx2 ? "avx2" : "generic"; }
+
+int packet_lanes(PacketIsa isa) {
+#if PDFLAB_PACKET_DISPATCH
+  if (isa == PacketIsa::Avx2) return packet_avx2::W;
+#else
+  (void)isa;
+#endif
+  return packet_generic::W;
 }
 
 void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,

@@ -1,10 +1,11 @@
 #pragma once
-// The book's estimator for eight paths at once. Each SIMD lane carries one
-// path; a lane whose path ends takes the next pixel sample at once, so the
-// lanes stay full. Intersection (every primitive against eight rays) and the
-// diffuse bounce's sampling and mixture pdf run in SIMD; the rest (materials
-// other than lambertian, emission, light-sa's set-up) runs per lane with the
-// scalar code.
+// The book's estimator for several paths at once: eight with AVX2, four with
+// SSE2 or NEON. Each SIMD lane carries one path; a lane whose path ends takes
+// the next pixel sample at once, so the lanes stay full. Intersection (every
+// primitive against all the lanes' rays), hits, emission, the diffuse bounce's
+// sampling and mixture pdf, glass, metal and the spawned rays run for all
+// lanes at once; random numbers (each path draws from its own stream) and
+// light-sa's double-precision set-up run per lane.
 //
 // Every operation mirrors trace_path's, in the same order and precision, and
 // a sample's random numbers come from its own stream as before, so a sample's
@@ -14,6 +15,7 @@
 #include "renderer/integrator/integrator.h"
 
 #include <cstdint>
+#include <string_view>
 
 namespace pdflab {
 
@@ -36,8 +38,11 @@ struct SampleResult {
 bool packet_supports(const SamplingPlan& plan);
 
 enum class PacketIsa : std::uint8_t { Generic, Avx2 };
-// The widest instruction set trace_block uses on this machine.
+// The instruction set trace_block uses: the widest this machine has, or the
+// baseline when the environment sets PDFLAB_ISA=generic.
 PacketIsa best_packet_isa();
+std::string_view packet_isa_name(PacketIsa isa);
+int packet_lanes(PacketIsa isa);  // paths traced together
 
 // Renders every sample of the block; out[(pixel row-major within the block) * spp + k]
 // receives sample first_sample + k. The plan must be supported.
