@@ -140,8 +140,8 @@ void RenderSession::finish_pass_locked() {
   }
   const double pass_ms = std::chrono::duration<double, std::milli>(now - pass_started_).count();
   if (pass_.preview) {
-    std::vector<float> rgb = preview_;
-    publish_locked(rgb, pass_);
+    spare_rgb_.assign(preview_.begin(), preview_.end());
+    publish_locked(spare_rgb_, pass_);
     if (paused_) {
       seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
       running_clock_ = false;
@@ -159,10 +159,9 @@ void RenderSession::finish_pass_locked() {
   // One sweep over the film per pass for the image and its noise (a few ms at
   // 600x600 against passes of 30-120 ms), so a viewer shows noise without ever
   // touching the film.
-  std::vector<float> rgb;
-  noise_ = noise_summary(film_, spare_rse_, kRelMseEpsilon, &rgb);
+  noise_ = noise_summary(film_, spare_rse_, kRelMseEpsilon, &spare_rgb_);
   spare_drops_ = film_.drop_masks();
-  publish_locked(rgb, pass_);
+  publish_locked(spare_rgb_, pass_);
 
   // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
   if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;

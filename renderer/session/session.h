@@ -188,7 +188,10 @@ class RenderSession {
   ImageInfo image_info_;
   std::vector<float> image_rse_;            // published with image_, empty for a preview
   std::vector<std::uint8_t> image_drops_;
-  std::vector<float> spare_rse_;            // filled under mutex_, then swapped in
+  // Filled under mutex_, then swapped with the published ones: the buffers of
+  // the pass before are reused, not allocated (and faulted in) again.
+  std::vector<float> spare_rgb_;
+  std::vector<float> spare_rse_;
   std::vector<std::uint8_t> spare_drops_;
 };
 
