@@ -10,6 +10,7 @@
 #include "renderer/scene/scene.h"
 
 #include <gtest/gtest.h>
+#include <pcg_random.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -57,6 +58,21 @@ TEST(Onb, NearlyAxisNormals) {
                         Vec3(1e-4f, 0, -1), Vec3(0, 1e-3f, -1), Vec3(1, 1e-7f, 1e-7f), Vec3(1e-7f, -1, -1e-7f),
                         Vec3(-1, 0, -1e-7f)})
     expect_right_handed_orthonormal(normalize(n));
+}
+
+// Rng is PCG32 written out; pcg-cpp's pcg32 is the oracle.
+TEST(Rng, SameNumbersAsPcgCpp) {
+  for (std::uint64_t seed : {0ull, 1ull, 42ull, 0x9e3779b97f4a7c15ull, ~0ull})
+    for (std::uint64_t stream : {0ull, 7ull, 0x632be59bd9b4e019ull, ~0ull}) {
+      Rng ours(seed, stream);
+      pcg32 theirs(seed, stream);
+      for (int i = 0; i < 1000; ++i) ASSERT_EQ(ours.next_u32(), theirs()) << seed << " " << stream << " " << i;
+    }
+  Rng a(3, 4);
+  const std::uint64_t state = a.state();
+  const std::uint32_t first = a.next_u32();
+  EXPECT_EQ(first, Rng::output(state));
+  EXPECT_EQ(a.state(), state * Rng::kMultiplier + a.increment());
 }
 
 TEST(Onb, RandomNormals) {

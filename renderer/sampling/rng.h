@@ -1,8 +1,6 @@
 #pragma once
 // Deterministic random numbers. A sample's stream depends only on
 // (seed, pixel, sample index), never on which thread renders it.
-#include <pcg_random.hpp>
-
 #include <cstdint>
 
 namespace pdflab {
@@ -15,9 +13,15 @@ constexpr std::uint64_t mix64(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// PCG32 (O'Neill's XSH RR 64/32 with a selectable stream): the same numbers as
+// pcg-cpp's pcg32 (tests/test_sampling_unit.cpp compares them), written out so
+// that the packet tracer can step eight streams at once with the same arithmetic.
 class Rng {
  public:
-  Rng(std::uint64_t state, std::uint64_t stream) : pcg_(state, stream) {}
+  static constexpr std::uint64_t kMultiplier = 6364136223846793005ULL;
+
+  Rng(std::uint64_t seed, std::uint64_t stream)
+      : increment_((stream << 1) | 1u), state_((seed + increment_) * kMultiplier + increment_) {}
   Rng() : Rng(0, 0) {}  // a placeholder until a stream is assigned
 
   // The stream for one pixel sample.
@@ -31,12 +35,27 @@ class Rng {
     return Rng(key, mix64(key ^ 0x632be59bd9b4e019ULL));
   }
 
+  std::uint32_t next_u32() {
+    const std::uint64_t old = state_;
+    state_ = old * kMultiplier + increment_;
+    return output(old);
+  }
   // Uniform in [0, 1): 24 random bits, exact in float, never 1.
-  float uniform() { return static_cast<float>(pcg_() >> 8) * 0x1.0p-24f; }
-  std::uint32_t next_u32() { return pcg_(); }
+  float uniform() { return to_unit(next_u32()); }
+
+  // The parts, for stepping many streams in SIMD lanes.
+  std::uint64_t state() const { return state_; }
+  std::uint64_t increment() const { return increment_; }
+  static std::uint32_t output(std::uint64_t old) {
+    const auto xorshifted = static_cast<std::uint32_t>(((old >> 18) ^ old) >> 27);
+    const auto rot = static_cast<std::uint32_t>(old >> 59);
+    return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  }
+  static float to_unit(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1.0p-24f; }
 
  private:
-  pcg32 pcg_;
+  std::uint64_t increment_;  // odd; selects the stream
+  std::uint64_t state_;
 };
 
 }  // namespace pdflab
