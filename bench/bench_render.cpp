@@ -66,12 +66,8 @@ int main(int argc, char** argv) {
   const Strategy strategy = Strategy::parse(strategy_text);
   std::printf("scene %s, %dx%d, depth %d, strategy %s, %u spp per run, %d rounds\n", scene->name.c_str(),
               scene->camera.width, scene->camera.height, scene->max_depth, strategy.to_string().c_str(), spp, rounds);
-  const SamplingPlan plan = SamplingPlan::make(strategy, *scene);
   const PacketIsa isa = best_packet_isa();
-  if (packet_supports(plan))
-    std::printf("tracer: packets of %d paths (%s)\n", packet_lanes(isa), std::string(packet_isa_name(isa)).c_str());
-  else
-    std::printf("tracer: one path at a time\n");
+  std::printf("tracer: packets of %d paths (%s)\n", packet_lanes(isa), std::string(packet_isa_name(isa)).c_str());
 
   std::vector<double> one, all;
   bool identical = true;

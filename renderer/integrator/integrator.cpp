@@ -32,16 +32,6 @@ inline float schlick(float cosine, float eta_ratio) {
 
 }  // namespace
 
-// Weight of technique `a` against `b` for a sample both could have drawn.
-inline float mis_weight(float a, float b, MisHeuristic h) {
-  if (h == MisHeuristic::Power) {
-    a *= a;
-    b *= b;
-  }
-  if (a == kInf) return 1.0f;  // also keeps inf/inf from becoming NaN
-  return a / (a + b);
-}
-
 bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
                              Vec3& throughput, Rng& rng) {
   if (m.type == MaterialType::Metal) {

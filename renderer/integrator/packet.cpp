@@ -48,8 +48,6 @@ namespace packet_avx2 {
 #pragma GCC pop_options
 #endif
 
-bool packet_supports(const SamplingPlan& plan) { return !plan.nee_mis; }
-
 PacketIsa best_packet_isa() {
   // PDFLAB_ISA=generic keeps the baseline code (to compare, or to rule the wider code out).
   static const PacketIsa isa = [] {

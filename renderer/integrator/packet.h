@@ -4,8 +4,9 @@
 // the next pixel sample at once, so the lanes stay full. Intersection (every
 // primitive against all the lanes' rays), hits, emission, the diffuse bounce's
 // sampling and mixture pdf, glass, metal and the spawned rays run for all
-// lanes at once; random numbers (each path draws from its own stream) and
-// light-sa's double-precision set-up run per lane.
+// lanes at once, as do nee-mis's shadow rays; each path's random numbers come
+// from its own stream (stepped for all lanes at once with AVX2), and the
+// spherical rectangles of light-sa and nee-mis are set up per lane in double.
 //
 // Every operation mirrors trace_path's, in the same order and precision, and
 // a sample's random numbers come from its own stream as before, so a sample's
@@ -34,9 +35,6 @@ struct SampleResult {
   std::uint8_t drops;  // bit r: the sample was dropped for DropReason r
 };
 
-// Whether trace_block can render this plan (nee-mis is traced one path at a time).
-bool packet_supports(const SamplingPlan& plan);
-
 enum class PacketIsa : std::uint8_t { Generic, Avx2 };
 // The instruction set trace_block uses: the widest this machine has, or the
 // baseline when the environment sets PDFLAB_ISA=generic.
@@ -45,7 +43,7 @@ std::string_view packet_isa_name(PacketIsa isa);
 int packet_lanes(PacketIsa isa);  // paths traced together
 
 // Renders every sample of the block; out[(pixel row-major within the block) * spp + k]
-// receives sample first_sample + k. The plan must be supported.
+// receives sample first_sample + k.
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
                  SampleResult* out);
 // The same with a given instruction set (tests compare them); it must be available.

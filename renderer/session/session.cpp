@@ -4,6 +4,7 @@
 #include "renderer/metrics/metrics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -250,21 +251,21 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
   const int y0 = (tile / pass.tiles_x) * kTile;
   const int x1 = std::min(x0 + kTile, scene.camera.width);
   const int y1 = std::min(y0 + kTile, scene.camera.height);
-  const std::uint64_t seed = settings_.seed;
-  if (packet_supports(plan_)) {
-    // Eight paths at a time; the samples come back in order and are added to
-    // the film in the same order as below, so the sums are the same bits.
-    const SampleBlock block{x0, y0, x1, y1, pass.first_sample, pass.spp};
-    thread_local std::vector<SampleResult> results;
-    results.resize(block.size());
-    trace_block(scene, plan_, seed, block, results.data());
+  // Several paths at a time (packet.h), a few thousand samples per call into
+  // a buffer on the stack (no heap in the render loop). The samples come back
+  // in order and each pixel adds them in sample order, so the sums are the
+  // same bits for any thread count.
+  constexpr std::size_t kChunk = 4096;
+  std::array<SampleResult, kChunk> results;
+  const auto add = [&](const SampleBlock& block) {
+    trace_block(scene, plan_, settings_.seed, block, results.data());
     const SampleResult* r = results.data();
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
+    for (int y = block.y0; y < block.y1; ++y) {
+      for (int x = block.x0; x < block.x1; ++x) {
         const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +
                                   static_cast<std::size_t>(x);
         std::uint8_t dropped = 0;
-        for (std::uint32_t s = 0; s < pass.spp; ++s, ++r) {
+        for (std::uint32_t s = 0; s < block.spp; ++s, ++r) {
           film_.add(pixel, r->radiance);
           dropped |= r->drops;
           for (int reason = 0; reason < kDropReasonCount; ++reason)
@@ -273,18 +274,20 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
         if (dropped) film_.mark_drops(pixel, dropped);
       }
     }
+  };
+  const std::size_t row_samples = static_cast<std::size_t>(x1 - x0) * pass.spp;
+  if (row_samples <= kChunk) {  // whole rows at a time
+    const int rows = static_cast<int>(kChunk / row_samples);
+    for (int y = y0; y < y1; y += rows) add(SampleBlock{x0, y, x1, std::min(y + rows, y1), pass.first_sample, pass.spp});
     return;
   }
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) {
-      const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(scene.camera.width) +
-                                static_cast<std::size_t>(x);
-      const DropCounts before = drops;
-      for (std::uint32_t s = pass.first_sample; s < pass.first_sample + pass.spp; ++s)
-        film_.add(pixel, render_pixel_sample(scene, plan_, seed, x, y, s, drops));
-      if (drops.total() != before.total()) film_.mark_drops(pixel, drop_reason_bits(before, drops));
-    }
-  }
+  for (int y = y0; y < y1; ++y)  // a pixel's samples in runs, in order
+    for (int x = x0; x < x1; ++x)
+      for (std::uint32_t done = 0; done < pass.spp;) {
+        const auto n = static_cast<std::uint32_t>(std::min<std::size_t>(kChunk, pass.spp - done));
+        add(SampleBlock{x, y, x + 1, y + 1, pass.first_sample + done, n});
+        done += n;
+      }
 }
 
 void RenderSession::render_preview_tile(const Pass& pass, int tile, DropCounts& drops) {
