@@ -30,10 +30,10 @@ inline float schlick(float cosine, float eta_ratio) {
   return r0 + (1.0f - r0) * m2 * m2 * m;
 }
 
-}  // namespace
-
+// Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
+// ray); returns false when the path ends (absorbed).
 bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
-                             Vec3& throughput, Rng& rng) {
+                      Vec3& throughput, Rng& rng) {
   if (m.type == MaterialType::Metal) {
     Vec3 dir = reflect(ray.direction, normal);
     if (m.fuzz > 0.0f) dir = normalize(dir + random_unit_vector(rng) * m.fuzz);
@@ -58,6 +58,8 @@ bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, boo
   ray = spawn_ray(hit.point, hit.normal, dir);
   return true;
 }
+
+}  // namespace
 
 // Next-event estimation with MIS: at each diffuse vertex one light sample
 // (shadow ray, solid-angle sampling of the emitters chosen by power) and one
@@ -201,7 +203,7 @@ inline std::uint32_t sobol_dim2(std::uint32_t index) {
 }  // namespace
 
 SampleSeed::SampleSeed(std::uint64_t seed_value)
-    : seed(seed_value), rng_key(Rng::seed_key(seed_value)), scramble_key(mix64(seed_value ^ 0x5bd1e995u)) {}
+    : rng_key(Rng::seed_key(seed_value)), scramble_key(mix64(seed_value ^ 0x5bd1e995u)) {}
 
 PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, int x, int y,
                                     std::uint32_t sample_index) {

@@ -58,11 +58,6 @@ inline float mis_weight(float a, float b, MisHeuristic h) {
   return a / (a + b);
 }
 
-// Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
-// ray); returns false when the path ends (absorbed).
-bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
-                      Vec3& throughput, Rng& rng);
-
 // The camera ray and the random stream of one pixel sample.
 struct PixelSampleStart {
   Ray ray;
@@ -71,7 +66,7 @@ struct PixelSampleStart {
 // The seed's share of every sample's stream and scramble, computed once.
 struct SampleSeed {
   explicit SampleSeed(std::uint64_t seed);
-  std::uint64_t seed, rng_key, scramble_key;
+  std::uint64_t rng_key, scramble_key;
 };
 PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, int x, int y,
                                     std::uint32_t sample_index);

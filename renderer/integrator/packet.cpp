@@ -2,9 +2,9 @@
 
 #include <array>
 #include <cstdlib>
-#include <string_view>
 #include <cstring>
 #include <numbers>
+#include <string_view>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -14,10 +14,10 @@
 #endif
 
 // With GCC on x86-64 the kernel is compiled a second time for AVX2 (eight
-// lanes in one register, against four with SSE2), chosen at run time, so a portable build still uses
-// the machine it runs on. The arithmetic is the same IEEE operations in the
-// same order either way (no FMA contraction in ISO C++ mode), so both give the
-// same bits. Helpers from other headers are compiled for the baseline and may
+// lanes in one register, against four with SSE2), chosen at run time, so a
+// portable build still uses the machine it runs on. The arithmetic is the same
+// IEEE operations in the same order either way (the build turns off FMA
+// contraction), so both give the same bits. Helpers from other headers are compiled for the baseline and may
 // be inlined into the AVX2 code, never the other way round.
 #if PDFLAB_PACKET_X86 && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
 #define PDFLAB_PACKET_DISPATCH 1

@@ -22,7 +22,6 @@ class Rng {
 
   Rng(std::uint64_t seed, std::uint64_t stream)
       : increment_((stream << 1) | 1u), state_((seed + increment_) * kMultiplier + increment_) {}
-  Rng() : Rng(0, 0) {}  // a placeholder until a stream is assigned
 
   // The stream for one pixel sample.
   static Rng for_sample(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {
