@@ -10,6 +10,8 @@
 #include "renderer/session/session.h"
 #include "renderer/metrics/statistics.h"
 
+#include "tests/render_support.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -89,15 +91,7 @@ struct BlockImage {
 
 BlockImage render_blocks(const std::string& strategy, std::uint64_t seed, std::uint32_t spp,
                          std::shared_ptr<const Scene> scene = book_scene()) {
-  RenderSession session(2);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = Strategy::parse(strategy);
-  settings.seed = seed;
-  settings.target_spp = spp;
-  session.set_settings(settings);
-  EXPECT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
-  const Film film = session.copy_film();
+  const Film film = testing::render_to_completion(scene, strategy, spp, seed, 2, std::chrono::seconds(300)).film;
 
   BlockImage b;
   constexpr double kPixels = kBlock * kBlock;

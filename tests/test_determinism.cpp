@@ -6,6 +6,8 @@
 #include "renderer/session/session.h"
 #include "tests/support.h"
 
+#include "tests/render_support.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -75,16 +77,10 @@ TEST(Determinism, SeedChangesTheImage) {
 
 // The same through the library: threads and pass sizes vary, sums must not.
 Film render_film(const std::shared_ptr<const Scene>& scene, int threads, std::uint64_t seed) {
-  RenderSession session(threads);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = Strategy::parse("mix:cosine=0.5,light=0.5");
-  settings.seed = seed;
-  settings.target_spp = 6;
-  session.set_settings(settings);
-  EXPECT_TRUE(session.wait_until_done(std::chrono::seconds(60))) << "render did not finish";
-  EXPECT_EQ(session.stats().spp, 6u);
-  return session.copy_film();
+  testing::Rendered r =
+      testing::render_to_completion(scene, "mix:cosine=0.5,light=0.5", 6, seed, threads, std::chrono::seconds(60));
+  EXPECT_EQ(r.stats.spp, 6u);
+  return std::move(r.film);
 }
 
 std::shared_ptr<const Scene> small_book_scene() {

@@ -6,6 +6,8 @@
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
+#include "tests/render_support.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,22 +23,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Rendered {
-  Film film;
-  SessionStats stats;
-};
+using testing::Rendered;
 
 Rendered render(const std::shared_ptr<const Scene>& scene, const std::string& strategy, std::uint32_t spp,
                 std::uint64_t seed = 5, int threads = 2) {
-  RenderSession session(threads);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = Strategy::parse(strategy);
-  settings.seed = seed;
-  settings.target_spp = spp;
-  session.set_settings(settings);
-  session.wait_until_done();
-  return {session.copy_film(), session.stats()};
+  return testing::render_to_completion(scene, strategy, spp, seed, threads, std::chrono::seconds(300));
 }
 
 std::shared_ptr<Scene> load(const std::string& name, int width, int height) {

@@ -11,6 +11,8 @@
 #include "renderer/session/session.h"
 #include "renderer/metrics/statistics.h"
 
+#include "tests/render_support.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,16 +74,10 @@ std::shared_ptr<const Scene> furnace_scene() {
 }
 
 Film render(const std::string& strategy, std::uint64_t seed) {
-  RenderSession session(2);
-  RenderSettings settings;
-  settings.scene = furnace_scene();
-  settings.strategy = Strategy::parse(strategy);
-  settings.seed = seed;
-  settings.target_spp = kSpp;
-  session.set_settings(settings);
-  EXPECT_TRUE(session.wait_until_done(std::chrono::seconds(120)));
-  EXPECT_EQ(session.stats().dropped.total(), 0u);
-  return session.copy_film();
+  testing::Rendered r =
+      testing::render_to_completion(furnace_scene(), strategy, kSpp, seed, 2, std::chrono::seconds(120));
+  EXPECT_EQ(r.stats.dropped.total(), 0u);
+  return std::move(r.film);
 }
 
 enum class Coverage { Sphere, Background, Edge };

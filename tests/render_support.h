@@ -1,0 +1,36 @@
+#pragma once
+// A render through the library as the tests want it: a fresh session renders
+// a scene to a fixed number of samples per pixel and is waited for.
+#include "renderer/film/film.h"
+#include "renderer/session/session.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace pdflab::testing {
+
+struct Rendered {
+  Film film;
+  SessionStats stats;
+};
+
+// Fails the test (and returns what there is) when the render takes longer than `timeout`.
+inline Rendered render_to_completion(std::shared_ptr<const Scene> scene, const std::string& strategy,
+                                     std::uint32_t spp, std::uint64_t seed, int threads,
+                                     std::chrono::seconds timeout) {
+  RenderSession session(threads);
+  RenderSettings settings;
+  settings.scene = std::move(scene);
+  settings.strategy = Strategy::parse(strategy);
+  settings.seed = seed;
+  settings.target_spp = spp;
+  session.set_settings(settings);
+  EXPECT_TRUE(session.wait_until_done(timeout)) << "the render did not finish in " << timeout.count() << " s";
+  return {session.copy_film(), session.stats()};
+}
+
+}  // namespace pdflab::testing
