@@ -46,6 +46,47 @@ bool TeachingViews::on_key(int key, RenderSession& main, bool paused) {
   }
 }
 
+bool TeachingViews::on_escape() {
+  if (probe_.mode || probe_.open) {
+    probe_.mode = false;
+    probe_.open = false;
+    return true;
+  }
+  if (lab_open_) {
+    lab_open_ = false;
+    return true;
+  }
+  return false;
+}
+
+void TeachingViews::probe_at(const RenderSession& main, int x, int y, bool side_b) {
+  const RenderSettings ms = main.settings();
+  // In the split, a click probes the strategy of the side it lands on.
+  Strategy strategy = ms.strategy;
+  if (side_b && !b_running_.empty()) strategy = Strategy::parse(b_running_);
+  ui::probe_pixel(probe_, ms.scene, strategy, ms.seed, x, y);
+  probe_generation_ = main.generation();
+  probe_side_b_ = side_b;
+  probe_b_ = b_running_;
+  probe_width_ = ms.scene->camera.width;
+  probe_height_ = ms.scene->camera.height;
+}
+
+void TeachingViews::follow_probe(const RenderSession& main) {
+  if (!probe_.has_point) return;
+  const bool side_b = probe_side_b_ && split_.on;
+  if (main.generation() == probe_generation_ && side_b == probe_side_b_ && (!side_b || b_running_ == probe_b_)) return;
+  const RenderSettings ms = main.settings();
+  const int w = ms.scene->camera.width, h = ms.scene->camera.height;
+  // The same place in the picture when the resolution changed.
+  const auto rescale = [](int v, int from, int to) {
+    return from > 0 ? std::clamp(static_cast<int>((static_cast<double>(v) + 0.5) * to / from), 0, to - 1) : 0;
+  };
+  const bool open = probe_.open;
+  probe_at(main, rescale(probe_.pixel_x, probe_width_, w), rescale(probe_.pixel_y, probe_height_, h), side_b);
+  probe_.open = open;
+}
+
 void TeachingViews::enter_split(RenderSession& main) {
   split_.on = true;
   const ui::SplitThreads threads =
@@ -133,7 +174,10 @@ void TeachingViews::pull(RenderSession& session, std::vector<float>& image, Imag
 
 void TeachingViews::update(RenderSession& main, bool paused) {
   new_image_ = false;
-  if (!split_.on) return;
+  if (!split_.on) {
+    follow_probe(main);
+    return;
+  }
   main.set_paused(true);  // Space toggles it; the split sessions take the pause instead
   const RenderSettings ms = main.settings();
   if (main.generation() != seen_main_generation_) {
@@ -148,6 +192,7 @@ void TeachingViews::update(RenderSession& main, bool paused) {
       (reference_width_ != ms.scene->camera.width || reference_height_ != ms.scene->camera.height))
     split_.reference_status = "loaded, but " + std::to_string(reference_width_) + "x" +
                               std::to_string(reference_height_) + " is not the render's size";
+  follow_probe(main);
 }
 
 void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int framebuffer_height,
@@ -174,13 +219,8 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
   if (probe_.mode && !mouse_taken && !io.WantCaptureMouse && ImGui::IsMouseClicked(0)) {
     const RenderSettings ms = main.settings();
     const Camera& cam = ms.scene->camera;
-    if (const auto hit = ui::pixel_at(io.MousePos.x, io.MousePos.y, left, top, width, height, cam.width, cam.height)) {
-      // In the split, a click probes the strategy of the side it lands on.
-      Strategy strategy = ms.strategy;
-      if (split_.on && io.MousePos.x > split_.divider.x(left, width)) strategy = Strategy::parse(b_running_);
-      ui::probe_pixel(probe_, ms.scene, strategy, ms.seed, hit->x, hit->y);
-      probe_.open = true;
-    }
+    if (const auto hit = ui::pixel_at(io.MousePos.x, io.MousePos.y, left, top, width, height, cam.width, cam.height))
+      probe_at(main, hit->x, hit->y, split_.on && io.MousePos.x > split_.divider.x(left, width));
   }
   if (probe_.has_point && probe_.open) {
     // A cross on the probed pixel.
@@ -208,7 +248,7 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
                                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoInputs |
                                    ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
     if (ImGui::Begin("##probe_badge", nullptr, flags))
-      ImGui::TextColored(ImVec4(0.45f, 0.95f, 0.55f, 1.0f), "probe mode: click a pixel (P to leave)");
+      ImGui::TextColored(ImVec4(0.45f, 0.95f, 0.55f, 1.0f), "probe mode: click a pixel (P or Esc to leave)");
     ImGui::End();
   }
 

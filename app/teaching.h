@@ -8,6 +8,7 @@
 #include "ui/probe_panel.h"
 #include "ui/split_view.h"
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -24,6 +25,8 @@ class TeachingViews {
 
   // S split, P probe mode, L 1D lab, C chi-square at the probed point.
   bool on_key(int glfw_key, RenderSession& main, bool paused);
+  // Esc: leaves probe mode, else closes the 1D lab. False when neither was on.
+  bool on_escape();
   // Before drawing: keeps the split sessions in step with the main session
   // (which rests while the split renders) and collects their images.
   void update(RenderSession& main, bool paused);
@@ -32,6 +35,12 @@ class TeachingViews {
   void draw_ui(RenderSession& main, const ui::Viewport& image, int framebuffer_height, float framebuffer_scale,
                float area_width, float area_height);
   bool split_active() const { return split_.on; }
+  // The split's state for the side panel; null while it is off.
+  const ui::SplitState* split_state() const { return split_.on ? &split_ : nullptr; }
+  // Rendering time of the split's longer-running side (0 while it is off).
+  double split_seconds() const { return split_.on ? std::max(split_.a.seconds, split_.b.seconds) : 0.0; }
+  // The pixel probe's state (tests read its counts).
+  const ui::ProbeState& probe() const { return probe_; }
   // OpenGL: both halves into `where`, A left of the divider.
   void draw_split_image(const ui::Viewport& where, float exposure_ev, bool srgb);
   // Something changes on screen without input: a split image, the lab, a running check.
@@ -42,6 +51,11 @@ class TeachingViews {
   void leave_split(RenderSession& main, bool paused);
   void restart_split(const RenderSettings& main_settings);
   void load_reference();
+  // Probes pixel (x, y) of the main render with its strategy, or with B's.
+  void probe_at(const RenderSession& main, int x, int y, bool side_b);
+  // The probe follows the render: a new strategy, weights, scene or seed (a new
+  // generation), or a new B, probes the same pixel again.
+  void follow_probe(const RenderSession& main);
   void pull(RenderSession& session, std::vector<float>& image, ImageInfo& info, std::uint64_t& version, bool& stale,
             ui::SideFigures& figures);
 
@@ -49,6 +63,10 @@ class TeachingViews {
   ui::SplitState split_;
   ui::ProbeState probe_;
   ui::Lab1dState lab_;
+  std::uint64_t probe_generation_ = 0;
+  bool probe_side_b_ = false;
+  std::string probe_b_;  // B's strategy when B was probed
+  int probe_width_ = 0, probe_height_ = 0;  // the render's size when probed
   bool lab_open_ = false;
 
   std::unique_ptr<RenderSession> a_, b_;

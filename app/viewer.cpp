@@ -20,6 +20,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
+#include <imgui_internal.h>  // ClosePopupToLevel: Esc closes a drop-down
 
 #include <algorithm>
 #include <chrono>
@@ -107,7 +108,10 @@ struct Viewer::Impl {
   std::uint64_t image_version = 0;
   bool texture_stale = false;
 
-  std::vector<int> keys;  // pressed since the last frame, from the GLFW callback
+  struct KeyPress {
+    int key = 0, mods = 0;
+  };
+  std::vector<KeyPress> keys;  // pressed since the last frame, from the GLFW callback
   // Redrawing costs CPU time the render threads could use (and llvmpipe draws
   // on the CPU), so a frame is drawn only when something on it can change.
   std::uint64_t input_events = 0, seen_input_events = 0;
@@ -115,6 +119,12 @@ struct Viewer::Impl {
   Clock::time_point last_draw{};
 
   bool screenshot_wanted = false;
+  // Quitting: Ctrl+Q or the window's close button; asks first when a render
+  // would be lost (see ui::unsaved_seconds).
+  ui::SaveMark last_save;  // the last saved image's generation and seconds
+  bool quit_asking = false;
+  bool quit_after_save = false;
+  bool close_popups = false;  // Esc with a drop-down open
   std::future<ui::SavedScreenshot> save_job;
   ui::ScreenshotData saving;  // kept until the job reports, for a retry after failure
   std::optional<ui::ScreenshotData> failed_save;
@@ -135,7 +145,10 @@ struct Viewer::Impl {
   void close();
   void open_window(int image_width, int image_height);
   void rebuild_fonts();
-  void on_key(int key);
+  void on_key(int key, int mods);
+  void on_escape();
+  void request_quit();
+  double unsaved_seconds() const;
   bool apply_render_settings();
   void load_scene(const std::string& path);
   void pull_image();
@@ -229,9 +242,14 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   glfwSetWindowUserPointer(window, this);
   // Installed before ImGui's, which then chains to them.
   static constexpr auto self = [](GLFWwindow* w) { return static_cast<Impl*>(glfwGetWindowUserPointer(w)); };
-  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int mods) {
     ++self(w)->input_events;
-    if (action == GLFW_PRESS) self(w)->keys.push_back(key);
+    if (action == GLFW_PRESS) self(w)->keys.push_back({key, mods});
+  });
+  // The close button asks like Ctrl+Q does.
+  glfwSetWindowCloseCallback(window, [](GLFWwindow* w) {
+    ++self(w)->input_events;
+    self(w)->request_quit();
   });
   glfwSetCharCallback(window, [](GLFWwindow* w, unsigned int) { ++self(w)->input_events; });
   glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int, int, int) { ++self(w)->input_events; });
@@ -393,9 +411,52 @@ void Viewer::Impl::load_scene(const std::string& path) {
   status.scene_files = list_scene_files();
 }
 
-void Viewer::Impl::on_key(int key) {
+double Viewer::Impl::unsaved_seconds() const {
+  const SessionStats st = session->stats();
+  double seconds = ui::unsaved_seconds(last_save, st.generation, st.seconds);
+  // In the split the main session rests; the two sides' rendering is at stake.
+  if (teaching->split_active()) seconds = std::max(seconds, teaching->split_seconds());
+  return seconds;
+}
+
+void Viewer::Impl::request_quit() {
+  if (cli_mode() || quit_asking || unsaved_seconds() <= ui::kUnsavedAskSeconds) {
+    glfwSetWindowShouldClose(window, GLFW_TRUE);
+    return;
+  }
+  glfwSetWindowShouldClose(window, GLFW_FALSE);
+  quit_asking = true;
+  settle_frames = 3;
+}
+
+void Viewer::Impl::on_escape() {
+  // Esc closes or cancels, innermost first, and never quits. ImGui itself closes
+  // an open drop-down and cancels a text edit (the key is then ignored here).
+  if (quit_asking) {
+    quit_asking = quit_after_save = false;
+    return;
+  }
+  if (ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId)) {
+    close_popups = true;  // in the next frame (ImGui closes popups on Esc only with keyboard navigation on)
+    return;
+  }
+  if (teaching->on_escape()) return;
+  if (panel.show_help) panel.show_help = false;
+}
+
+void Viewer::Impl::on_key(int key, int mods) {
+  if (key == GLFW_KEY_Q && (mods & GLFW_MOD_CONTROL)) {
+    request_quit();  // while asking, Ctrl+Q again is "quit anyway"
+    return;
+  }
+  if (key == GLFW_KEY_ESCAPE) {
+    // A text field being edited takes Esc as "cancel": nothing else happens.
+    if (!ImGui::GetIO().WantTextInput) on_escape();
+    return;
+  }
+  if (quit_asking) return;
   // Typing a path must not pause the render or restart it.
-  if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12 && key != GLFW_KEY_ESCAPE) return;
+  if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12) return;
   if (teaching->on_key(key, *session, settings.paused)) return;
   switch (key) {
     case GLFW_KEY_SPACE:
@@ -404,7 +465,6 @@ void Viewer::Impl::on_key(int key) {
       break;
     case GLFW_KEY_R: apply_render_settings(); break;
     case GLFW_KEY_F12: screenshot_wanted = true; break;
-    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
     case GLFW_KEY_1:
     case GLFW_KEY_2:
     case GLFW_KEY_3:
@@ -450,6 +510,7 @@ ui::ScreenshotData Viewer::Impl::capture() const {
   d.seed = applied.seed;
   d.max_depth = applied.max_depth;
   d.version = PDFLAB_VERSION;
+  d.generation = image_info.generation;
   return d;
 }
 
@@ -468,9 +529,9 @@ void Viewer::Impl::service_screenshots() {
   if (cli_mode() && !cli_done && current && image_info.spp >= options.spp) {
     cli_done = true;
     try {
-      const ui::SavedScreenshot saved = ui::save_screenshot_as(options.screenshot, capture());
+      const ui::SavedScreenshot files = ui::save_screenshot_as(options.screenshot, capture());
       std::printf("%u spp, %dx%d, %.2f s -> %s (+ %s, %s)\n", image_info.spp, image_info.width, image_info.height,
-                  image_info.seconds, saved.png.c_str(), saved.pfm.c_str(), saved.json.c_str());
+                  image_info.seconds, files.png.c_str(), files.pfm.c_str(), files.json.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "pdflab: error: screenshot not saved: %s\n", e.what());
       exit_status = 1;
@@ -480,16 +541,21 @@ void Viewer::Impl::service_screenshots() {
 
   if (save_job.valid() && save_job.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     try {
-      const ui::SavedScreenshot saved = save_job.get();
-      notice("Saved " + saved.png + "\n  + " + fs::path(saved.pfm).filename().string() + ", " +
-                 fs::path(saved.json).filename().string(),
+      const ui::SavedScreenshot files = save_job.get();
+      std::error_code ec;
+      const fs::path png = fs::absolute(files.png, ec);
+      notice("Saved " + (ec ? files.png : png.string()) + "\n  + " + fs::path(files.pfm).filename().string() + ", " +
+                 fs::path(files.json).filename().string(),
              false);
       failed_save.reset();
+      last_save = {saving.generation, saving.seconds};
+      if (quit_after_save) glfwSetWindowShouldClose(window, GLFW_TRUE);
     } catch (const std::exception& e) {
       notice(std::string("Screenshot NOT saved: ") + e.what() +
                  "\nThe image is kept: choose another folder and press Retry.",
              true);
       failed_save = std::move(saving);
+      quit_after_save = false;  // the question stays open, with the reason beside it
     }
   }
   if (save_job.valid()) return;
@@ -516,6 +582,7 @@ void Viewer::Impl::fill_status() {
   status.now = now();
   status.frame_ms = report.work_ms;
   status.measure = &measure;
+  status.split = teaching->split_state();
 }
 
 void Viewer::Impl::load_reference(const std::string& path) {
@@ -557,7 +624,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   v.report.new_image = false;
   v.report.drawn = false;
   glfwPollEvents();
-  for (int key : v.keys) v.on_key(key);
+  for (const Impl::KeyPress& k : v.keys) v.on_key(k.key, k.mods);
   v.keys.clear();
   v.pull_image();
   v.teaching->update(*v.session, v.settings.paused);
@@ -597,6 +664,8 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
+  if (v.close_popups) ImGui::ClosePopupToLevel(0, true);
+  v.close_popups = false;
   v.fill_status();
   const ImGuiIO& io = ImGui::GetIO();
   const float panel_width = std::min(kPanelWidth * v.content_scale / v.framebuffer_scale, io.DisplaySize.x);
@@ -617,6 +686,17 @@ bool Viewer::frame(bool paced, bool force_draw) {
     ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
     v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, io.DisplaySize.x - panel_width,
                         io.DisplaySize.y);
+  }
+  if (v.quit_asking) {
+    switch (ui::draw_quit_dialog(v.unsaved_seconds(), v.quit_after_save || v.save_job.valid(), v.status.notice)) {
+      case ui::QuitChoice::SaveAndQuit:
+        v.quit_after_save = true;
+        v.screenshot_wanted = true;
+        break;
+      case ui::QuitChoice::Quit: glfwSetWindowShouldClose(v.window, GLFW_TRUE); break;
+      case ui::QuitChoice::Cancel: v.quit_asking = v.quit_after_save = false; break;
+      case ui::QuitChoice::None: break;
+    }
   }
   ImGui::Render();
 

@@ -3,6 +3,7 @@
 
 #include "renderer/integrator/integrator.h"
 #include "ui/measure_panel.h"
+#include "ui/split_view.h"
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
@@ -195,7 +196,44 @@ void display_section(ViewerSettings& settings) {
   draw_view_mode_selector(settings);
 }
 
+// In the split the main render rests: the two sides are what runs.
+void split_statistics(const SplitState& split) {
+  ImGui::TextColored(kAmber, "Split screen: A left, B right (S to leave)");
+  if (ImGui::BeginTable("split stats", 3, ImGuiTableFlags_SizingStretchProp | ImGuiTableFlags_RowBg)) {
+    ImGui::TableSetupColumn("");
+    ImGui::TableSetupColumn("A");
+    ImGui::TableSetupColumn("B");
+    ImGui::TableHeadersRow();
+    const auto row = [](const char* label, const std::string& a, const std::string& b) {
+      ImGui::TableNextColumn();
+      ImGui::TextColored(kDim, "%s", label);
+      ImGui::TableNextColumn();
+      ImGui::TextWrapped("%s", a.c_str());
+      ImGui::TableNextColumn();
+      ImGui::TextWrapped("%s", b.c_str());
+    };
+    const auto num = [](const char* fmt, double v) {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, fmt, v);
+      return std::string(buf);
+    };
+    const SideFigures &a = split.a, &b = split.b;
+    row("strategy", a.strategy + (a.unbiased ? "" : " (biased)"), b.strategy + (b.unbiased ? "" : " (biased)"));
+    row("spp", std::to_string(a.spp), std::to_string(b.spp));
+    row("elapsed", format_seconds(a.seconds), format_seconds(b.seconds));
+    row("samples/s", num("%.3f M", a.samples_per_second * 1e-6), num("%.3f M", b.samples_per_second * 1e-6));
+    row("noise", format_figure(a.noise, true), format_figure(b.noise, true));
+    row("efficiency", format_figure(a.efficiency()), format_figure(b.efficiency()));
+    ImGui::EndTable();
+  }
+  ImGui::TextColored(kDim, "%d threads a side; the main render rests meanwhile.", split.threads_per_side);
+}
+
 void statistics_section(const ViewerSettings& settings, const UiStatus& status) {
+  if (status.split) {
+    split_statistics(*status.split);
+    return;
+  }
   const SessionStats& st = status.stats;
   const std::uint64_t dropped = st.dropped.total();
   if (ImGui::BeginTable("stats", 4, ImGuiTableFlags_SizingStretchProp)) {
@@ -306,7 +344,8 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"P", "pixel probe: click a pixel (C: chi-square)"},
         {"L", "1D lab: f, p, inverse CDF, pi"},
         {"H, F1", "this help"},
-        {"Esc", "quit"},
+        {"Esc", "close a drop-down, cancel an edit, leave probe mode"},
+        {"Ctrl+Q", "quit (asks first when a render is unsaved)"},
     };
     for (const auto& k : kKeys) {
       ImGui::TextColored(kAmber, "%s", k[0]);
@@ -333,6 +372,45 @@ void draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
   if (ImGui::Begin("##badges", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text.c_str());
   ImGui::End();
+}
+
+QuitChoice draw_quit_dialog(double unsaved_seconds, bool saving, const Notice& notice) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  // A dimmed cover that takes every click, then the question on top of it.
+  ImGui::SetNextWindowPos(vp->Pos);
+  ImGui::SetNextWindowSize(vp->Size);
+  ImGui::SetNextWindowFocus();
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  const ImGuiWindowFlags cover = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoNav;
+  ImGui::Begin("##quit cover", nullptr, cover);
+  ImGui::End();
+  QuitChoice choice = QuitChoice::None;
+  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x * 0.5f, vp->Pos.y + vp->Size.y * 0.5f), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowFocus();
+  ImGui::SetNextWindowBgAlpha(1.0f);
+  const ImGuiWindowFlags dialog = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
+                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse;
+  if (ImGui::Begin("Quit pdflab?", nullptr, dialog)) {
+    ImGui::Text("This render has run %.0f s since it was last saved;", unsaved_seconds);
+    ImGui::Text("quitting loses it.");
+    if (notice.error && !notice.text.empty()) {
+      ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);
+      ImGui::TextColored(kRed, "%s", notice.text.c_str());
+      ImGui::PopTextWrapPos();
+    }
+    ImGui::Spacing();
+    ImGui::BeginDisabled(saving);
+    if (ImGui::Button(saving ? "Saving..." : "Save screenshot, then quit")) choice = QuitChoice::SaveAndQuit;
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    if (ImGui::Button("Quit anyway (Ctrl+Q)")) choice = QuitChoice::Quit;
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel (Esc)")) choice = QuitChoice::Cancel;
+  }
+  ImGui::End();
+  return choice;
 }
 
 }  // namespace pdflab::ui

@@ -20,4 +20,9 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height);
 // A short line over the image (preview, paused, biased), top-left of the image area.
 void draw_image_badges(const ViewerSettings& settings, const UiStatus& status);
 
+// The question before quitting with an unsaved render, over everything (the
+// rest of the window takes no input meanwhile).
+enum class QuitChoice { None, SaveAndQuit, Quit, Cancel };
+QuitChoice draw_quit_dialog(double unsaved_seconds, bool saving, const Notice& notice);
+
 }  // namespace pdflab::ui

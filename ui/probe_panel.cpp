@@ -76,6 +76,16 @@ void draw_disc(ImDrawList* list, ImVec2 centre, float radius, const char* label)
   list->AddText(ImVec2(centre.x - w * 0.5f, centre.y + radius + 3.0f), IM_COL32(175, 175, 185, 255), label);
 }
 
+bool is_light_technique(int t) {
+  return t == static_cast<int>(Technique::Light) || t == static_cast<int>(Technique::LightSolidAngle);
+}
+
+ImU32 sample_colour(const ProbeState& s, std::size_t i) {
+  const ProbeSample& sample = s.samples[i];
+  if (i < s.sample_target.size() && s.sample_target[i] >= 0) return target_colour(s.sample_target[i]);
+  return draw::technique_colour(sample.technique);
+}
+
 void directions_view(const ProbeState& s, float radius) {
   const float line = ImGui::GetTextLineHeight();
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
@@ -85,15 +95,26 @@ void directions_view(const ProbeState& s, float radius) {
   const ImVec2 lower(upper.x + radius * 2.0f + 24.0f, upper.y);
   draw_disc(list, upper, radius, "above (normal at centre)");
   draw_disc(list, lower, radius * 0.75f, "below the surface");
-  for (const ProbeSample& sample : s.samples) {
+  for (std::size_t i = 0; i < s.samples.size(); ++i) {
+    const ProbeSample& sample = s.samples[i];
     if (sample.technique < 0) continue;
     float u = 0.0f, v = 0.0f;
     direction_to_map(s.point, sample.direction, u, v);
     const DiscPoint d = project_to_disc(u, v);
     const ImVec2 c = d.lower ? lower : upper;
     const float r = d.lower ? radius * 0.75f : radius;
-    list->AddCircleFilled(ImVec2(c.x + d.x * r, c.y - d.y * r), 2.2f, draw::technique_colour(sample.technique), 8);
+    list->AddCircleFilled(ImVec2(c.x + d.x * r, c.y - d.y * r), 2.2f, sample_colour(s, i), 8);
   }
+}
+
+void legend_entry(ImU32 colour, const char* label, int count, float indent) {
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  const float line = ImGui::GetTextLineHeight();
+  ImGui::GetWindowDrawList()->AddCircleFilled(ImVec2(p.x + indent + line * 0.4f, p.y + line * 0.5f), line * 0.3f,
+                                              colour, 12);
+  ImGui::Dummy(ImVec2(indent + line, line));
+  ImGui::SameLine();
+  ImGui::Text("%s  %d", label, count);
 }
 
 void legend(const ProbeState& s) {
@@ -101,14 +122,17 @@ void legend(const ProbeState& s) {
     const int count = s.technique_counts[static_cast<std::size_t>(t)];
     if (count == 0) continue;
     const bool none = t == kTechniqueCount;
-    const ImU32 col = draw::technique_colour(none ? -1 : t);
-    const ImVec2 p = ImGui::GetCursorScreenPos();
-    const float line = ImGui::GetTextLineHeight();
-    ImGui::GetWindowDrawList()->AddCircleFilled(ImVec2(p.x + line * 0.4f, p.y + line * 0.5f), line * 0.3f, col, 12);
-    ImGui::Dummy(ImVec2(line, line));
-    ImGui::SameLine();
-    ImGui::Text("%s  %d", none ? "no direction" : std::string(technique_name(static_cast<Technique>(t))).c_str(),
-                count);
+    const std::string name = none ? "no direction" : std::string(technique_name(static_cast<Technique>(t)));
+    legend_entry(draw::technique_colour(none ? -1 : t), name.c_str(), count, 0.0f);
+    if (none || !is_light_technique(t)) continue;
+    // The light technique's samples split by the target they aim at.
+    for (std::size_t k = 0; k < s.target_labels.size(); ++k) {
+      int n = 0;
+      for (std::size_t i = 0; i < s.samples.size() && i < s.sample_target.size(); ++i)
+        n += s.samples[i].technique == t && s.sample_target[i] == static_cast<int>(k);
+      if (n > 0) legend_entry(target_colour(static_cast<int>(k)), ("to " + s.target_labels[k]).c_str(), n,
+                              ImGui::GetTextLineHeight());
+    }
   }
 }
 
@@ -184,6 +208,40 @@ std::optional<PixelHit> pixel_at(float px, float py, float rect_x, float rect_y,
   return hit;
 }
 
+int light_target_of(const SamplingPlan& plan, const Vec3& origin, const Vec3& direction) {
+  // Each target alone as a set of one: its pdf is positive exactly where it is seen.
+  const TargetSet& all = plan.book_targets;
+  int best = -1;
+  float best_pdf = 0.0f;
+  const auto consider = [&](TargetSet one, int index) {
+    one.set_probabilities({1.0});
+    const float p = one.pdf(origin, direction);
+    if (p > best_pdf) {
+      best_pdf = p;
+      best = index;
+    }
+  };
+  int index = 0;
+  for (const auto& q : all.quads) {
+    TargetSet one;
+    one.quads.push_back(q);
+    consider(std::move(one), index++);
+  }
+  for (const auto& sp : all.spheres) {
+    TargetSet one;
+    one.spheres.push_back(sp);
+    consider(std::move(one), index++);
+  }
+  return best;
+}
+
+std::uint32_t target_colour(int target) {
+  static constexpr ImU32 kColours[] = {IM_COL32(255, 215, 70, 255), IM_COL32(80, 235, 235, 255),
+                                       IM_COL32(255, 120, 200, 255), IM_COL32(170, 255, 120, 255),
+                                       IM_COL32(255, 150, 90, 255)};
+  return kColours[static_cast<std::size_t>(std::max(0, target)) % std::size(kColours)];
+}
+
 BandHistogram cos_theta_bands(const ProbeChiSquare& chi) {
   BandHistogram b;
   b.observed.assign(static_cast<std::size_t>(std::max(0, chi.z_cells)), 0.0);
@@ -202,6 +260,7 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   // A running check reads the old plan and scene through its own copies of the pointers.
   s.has_point = true;
   s.open = true;
+  ++s.serial;
   s.pixel_x = x;
   s.pixel_y = y;
   s.strategy_text = strategy.to_string();
@@ -209,6 +268,8 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   s.scene = std::move(scene);
   s.point = first_diffuse_hit(*s.scene, x, y, seed);
   s.samples.clear();
+  s.sample_target.clear();
+  s.target_labels.clear();
   std::fill(s.technique_counts.begin(), s.technique_counts.end(), 0);
   try {
     s.plan = std::make_shared<const SamplingPlan>(SamplingPlan::make(strategy, *s.scene));
@@ -217,8 +278,18 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   }
   if (s.point.found && s.plan) {
     s.samples = probe_directions(*s.plan, s.point, kProbeDirections, seed);
-    for (const ProbeSample& p : s.samples)
+    for (const ProbeSample& p : s.samples) {
       ++s.technique_counts[static_cast<std::size_t>(p.technique < 0 ? kTechniqueCount : p.technique)];
+      s.sample_target.push_back(is_light_technique(p.technique) ? light_target_of(*s.plan, s.point.point, p.direction)
+                                                                : -1);
+    }
+    const Scene& sc = *s.scene;
+    const auto label = [&](std::uint32_t material, const char* kind) {
+      const std::string name = material < sc.material_names.size() ? sc.material_names[material] : "target";
+      return name + " (" + kind + ")";
+    };
+    for (const auto& q : s.plan->book_targets.quads) s.target_labels.push_back(label(q.quad->material, "quad"));
+    for (const auto& sp : s.plan->book_targets.spheres) s.target_labels.push_back(label(sp.sphere->material, "sphere"));
   }
   s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
                             s.point, kMapWidth, kMapHeight);
@@ -232,6 +303,7 @@ void start_probe_chi_square(ProbeState& s, double now) {
   if (s.chi_running() || !s.plan || !s.point.found || s.plan->nee_mis) return;
   s.chi.reset();
   s.chi_started = now;
+  s.chi_serial = s.serial;
   s.chi_job = std::async(std::launch::async, [plan = s.plan, scene = s.scene, at = s.point] {
     (void)scene;  // the plan points into it
     return probe_chi_square(*plan, at, kChiSamples, 1);
@@ -240,7 +312,9 @@ void start_probe_chi_square(ProbeState& s, double now) {
 
 bool poll_probe_chi_square(ProbeState& s, double now) {
   if (!s.chi_job.valid() || s.chi_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
-  s.chi = s.chi_job.get();
+  ProbeChiSquare result = s.chi_job.get();
+  if (s.chi_serial != s.serial) return false;  // for a probe since replaced
+  s.chi = std::move(result);
   s.chi_seconds = now - s.chi_started;
   return true;
 }
@@ -255,7 +329,8 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   const float w = std::min(display.x - 20.0f, 600.0f), h = std::min(display.y - 20.0f, 760.0f);
   ImGui::SetNextWindowPos(ImVec2(display.x - w - 10.0f, 10.0f), ImGuiCond_Appearing);
   ImGui::SetNextWindowSize(ImVec2(w, h), ImGuiCond_Appearing);
-  ImGui::SetNextWindowBgAlpha(0.97f);
+  // Opaque: the panel's text beneath must not show through.
+  ImGui::SetNextWindowBgAlpha(1.0f);
   if (!ImGui::Begin("Pixel probe (P)", &s.open, ImGuiWindowFlags_NoSavedSettings)) {
     ImGui::End();
     return;

@@ -58,12 +58,19 @@ struct ProbeState {
   ProbePoint point;
   std::vector<ProbeSample> samples;
   std::vector<int> technique_counts = std::vector<int>(kTechniqueCount + 1, 0);  // last: no direction
+  // Light samples by the importance target they aim at (quads, then spheres, as
+  // the plan lists them): the target's index per sample (-1: not a light
+  // sample) and a label per target, e.g. "light (quad)", "glass (sphere)".
+  std::vector<int> sample_target;
+  std::vector<std::string> target_labels;
   ProbeMap strategy_map, cosine_map, light_map;
 
   // Kept alive for the chi-square job, which reads both.
   std::shared_ptr<const Scene> scene;
   std::shared_ptr<const SamplingPlan> plan;
   std::future<ProbeChiSquare> chi_job;
+  int serial = 0;      // bumped by every probe_pixel
+  int chi_serial = 0;  // the probe the running check belongs to
   std::optional<ProbeChiSquare> chi;
   double chi_started = 0.0, chi_seconds = 0.0;
 
@@ -76,8 +83,15 @@ void probe_pixel(ProbeState& state, std::shared_ptr<const Scene> scene, const St
                  int x, int y);
 // Starts the chi-square check in the background (no-op while one runs).
 void start_probe_chi_square(ProbeState& state, double now);
-// Collects a finished check; true when one arrived.
+// Collects a finished check; true when one arrived for the current probe (a
+// check started before the last probe_pixel is dropped).
 bool poll_probe_chi_square(ProbeState& state, double now);
+
+// Which of the plan's importance targets a light direction aims at: its index
+// (quads, then spheres), the one of highest density when several overlap; -1 none.
+int light_target_of(const SamplingPlan& plan, const Vec3& origin, const Vec3& direction);
+// One colour per importance target in the probe's legend.
+std::uint32_t target_colour(int target);
 
 void draw_probe_panel(ProbeState& state, double now, float area_width, float area_height);
 

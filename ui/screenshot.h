@@ -25,6 +25,7 @@ struct ScreenshotData {
   std::uint64_t seed = 1;
   int max_depth = 0;
   std::string version;
+  std::uint64_t generation = 0;  // not in the sidecar: which render the viewer saved
 };
 
 struct SavedScreenshot {

@@ -1,5 +1,7 @@
 #include "ui/settings.h"
 
+#include <algorithm>
+
 namespace pdflab::ui {
 
 Strategy SamplingSettings::strategy() const {
@@ -40,6 +42,11 @@ std::array<float, kTechniqueCount> SamplingSettings::normalised() const {
   if (!(total > 0.0)) return out;
   for (int i = 0; i < kTechniqueCount; ++i) out[i] = static_cast<float>(w[i] / total);
   return out;
+}
+
+double unsaved_seconds(const SaveMark& saved, std::uint64_t generation, double seconds) {
+  if (saved.generation != generation) return seconds;
+  return std::max(0.0, seconds - saved.seconds);
 }
 
 const char* preset_label(Preset p) {

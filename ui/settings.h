@@ -12,6 +12,8 @@
 
 namespace pdflab::ui {
 
+struct SplitState;
+
 // The strategy as the panel edits it: one technique, or a mixture with one
 // slider per technique (raw weights; the renderer normalises them).
 struct SamplingSettings {
@@ -34,6 +36,16 @@ enum class Preset { CosineOnly = 1, LightOnly = 2, Book5050 = 3 };
 inline constexpr int kPresetCount = 3;
 const char* preset_label(Preset p);
 SamplingSettings preset_sampling(Preset p);
+
+// Quitting asks first when a render has run longer than this since it was last saved.
+inline constexpr double kUnsavedAskSeconds = 5.0;
+struct SaveMark {
+  std::uint64_t generation = ~std::uint64_t{0};  // none saved yet
+  double seconds = 0.0;                          // the saved image's rendering time
+};
+// Rendering seconds a quit would lose: all of them for a render never saved,
+// those since the save for the saved one.
+double unsaved_seconds(const SaveMark& saved, std::uint64_t generation, double seconds);
 
 struct ViewerSettings {
   SamplingSettings sampling;
@@ -89,6 +101,7 @@ struct UiStatus {
   double now = 0.0;
   double frame_ms = 0.0;
   const MeasureState* measure = nullptr;  // the viewer's; null in tests without one
+  const SplitState* split = nullptr;      // while the split screen is on: its two sides
 };
 
 // Text-field buffers and other panel-local state that is not a setting.

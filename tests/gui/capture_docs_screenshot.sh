@@ -3,6 +3,7 @@
 # captured after it has rendered for a while.
 #   tests/gui/capture_docs_screenshot.sh [PDFLAB] [SECONDS]
 set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 root=$(cd "$(dirname "$0")/../.." && pwd)
 pdflab=${1:-$root/build/release/app/pdflab}
 seconds=${2:-30}
@@ -17,6 +18,5 @@ xdotool mousemove 5 5
 sleep "$seconds"
 mkdir -p "$root/docs"
 import -window "$wid" "$root/docs/viewer.png"
-xdotool key --window "$wid" Escape
-wait $viewer
+quit_viewer "$wid" "$viewer"
 echo "wrote $root/docs/viewer.png"

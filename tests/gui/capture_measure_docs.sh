@@ -4,6 +4,7 @@
 # pinned curve, and the nee-mis note. The book's scene at 400x400 under Xvfb.
 #   tests/gui/capture_measure_docs.sh [PDFLAB] [SECONDS_PER_STRATEGY]
 set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 root=$(cd "$(dirname "$0")/../.." && pwd)
 pdflab=${1:-$root/build/release/app/pdflab}
 seconds=${2:-20}
@@ -24,7 +25,7 @@ start() {  # start STRATEGY: the viewer in the background, its window id in $wid
   wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
   xdotool mousemove 5 5
 }
-stop() { xdotool key --window "$wid" Escape; wait "$viewer"; }
+stop() { quit_viewer "$wid" "$viewer"; }
 shot() { import -window "$wid" "$root/docs/$1"; echo "wrote docs/$1"; }
 
 mkdir -p "$root/docs"

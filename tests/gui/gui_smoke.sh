@@ -53,8 +53,7 @@ xdotool key --window "$wid" F12
 for _ in $(seq 100); do [ "$(ls "$art"/shots/*.png 2>/dev/null | wc -l)" -ge 2 ] && break; sleep 0.2; done
 sleep 1
 import -window root "$art/window.png"
-xdotool key --window "$wid" Escape
-wait $viewer || fail "viewer exited with status $?"
+quit_viewer "$wid" "$viewer"
 trap - EXIT
 
 ls -l "$art/shots"

@@ -104,7 +104,6 @@ shot lab_later
 changed "$art/lab.png" "$art/lab_later.png"
 [ -n "$docs" ] && cp "$art/lab_later.png" "$docs/view_lab1d.png"
 
-xdotool key --window "$wid" Escape
-wait $viewer || fail "viewer exited with status $?"
+quit_viewer "$wid" "$viewer"
 trap - EXIT
 echo "PASS"

@@ -51,8 +51,7 @@ for i in "${!modes[@]}"; do
   convert "$art/window_${modes[$i]}.png" -crop "$crop" +repage "$art/${modes[$i]}.png"
 done
 xdotool key --window "$wid" v   # back to the image
-xdotool key --window "$wid" Escape
-wait $viewer || fail "viewer exited with status $?"
+quit_viewer "$wid" "$viewer"
 trap - EXIT
 
 for m in "${modes[@]}"; do
@@ -77,7 +76,6 @@ wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 xdotool mousemove 5 5
 sleep 3
 import -window "$wid" "$art/window_mismatch.png"
-xdotool key --window "$wid" Escape
-wait $viewer || fail "viewer exited with status $?"
+quit_viewer "$wid" "$viewer"
 trap - EXIT
 echo "PASS"

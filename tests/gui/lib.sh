@@ -19,3 +19,15 @@ inside_xvfb() {
 }
 
 fail() { echo "FAIL: $*"; exit 1; }
+
+# alive PID WHAT: the viewer is still running after WHAT.
+alive() { kill -0 "$1" 2>/dev/null || fail "the viewer quit after $2"; }
+# quit_viewer WID PID: Ctrl+Q, and Ctrl+Q again ("quit anyway") when it asks
+# first (a render of more than a few seconds, unsaved); waits for the exit
+# status, which must be 0.
+quit_viewer() {
+  xdotool key --window "$1" ctrl+q
+  for _ in $(seq 10); do kill -0 "$2" 2>/dev/null || break; sleep 0.1; done
+  if kill -0 "$2" 2>/dev/null; then xdotool key --window "$1" ctrl+q; fi
+  wait "$2" || fail "viewer exited with status $?"
+}

@@ -184,6 +184,45 @@ TEST(ProbeProjection, ProbingAFloorPixelFillsThePanelState) {
   EXPECT_TRUE(s.chi->passed) << s.chi->result.p_value;
 }
 
+TEST(ProbeProjection, LightSamplesAreSplitByTheTargetTheyAimAt) {
+  ProbeState s;
+  const auto scene = small_scene();
+  probe_pixel(s, scene, Strategy::parse("light"), 1, 30, 88);
+  ASSERT_TRUE(s.point.found);
+  // The book's targets: the ceiling light (a quad) and the glass sphere.
+  ASSERT_EQ(s.target_labels.size(), 2u);
+  EXPECT_NE(s.target_labels[0].find("quad"), std::string::npos);
+  EXPECT_NE(s.target_labels[1].find("sphere"), std::string::npos);
+  ASSERT_EQ(s.sample_target.size(), s.samples.size());
+  std::vector<int> per_target(2, 0);
+  for (std::size_t i = 0; i < s.samples.size(); ++i) {
+    if (s.samples[i].technique < 0) continue;
+    ASSERT_GE(s.sample_target[i], 0) << "a light sample aiming at no target";
+    ++per_target[static_cast<std::size_t>(s.sample_target[i])];
+  }
+  // Targets are chosen uniformly by `light`: about 200 each of 400.
+  EXPECT_GT(per_target[0], 140);
+  EXPECT_GT(per_target[1], 140);
+  // Straight down into the floor aims at no target.
+  EXPECT_EQ(light_target_of(*s.plan, s.point.point, -s.point.normal), -1);
+}
+
+TEST(ProbeProjection, ACheckStartedBeforeANewProbeIsDropped) {
+  ProbeState s;
+  const auto scene = small_scene();
+  probe_pixel(s, scene, Strategy::parse("cosine"), 1, 30, 88);
+  start_probe_chi_square(s, 0.0);
+  ASSERT_TRUE(s.chi_running());
+  // The strategy changes while it runs: the probe follows, the old check's result must not show.
+  probe_pixel(s, scene, Strategy::parse("light"), 1, 30, 88);
+  s.chi_job.wait();
+  EXPECT_FALSE(poll_probe_chi_square(s, 1.0));
+  EXPECT_FALSE(s.chi.has_value());
+  EXPECT_FALSE(s.chi_running());
+  EXPECT_EQ(s.technique_counts[0], 0);  // and the counts are the new strategy's
+  EXPECT_GT(s.technique_counts[3], 0);
+}
+
 TEST(Lab1d, BinsCoverTheIntervalHalfOpen) {
   EXPECT_EQ(lab_bin(0.0, 40), 0);
   EXPECT_EQ(lab_bin(0.0499, 40), 0);

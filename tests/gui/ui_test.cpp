@@ -59,6 +59,15 @@ TEST(SamplingSettings, AllZeroWeightsNormaliseToZero) {
   for (float w : s.normalised()) EXPECT_EQ(w, 0.0f);
 }
 
+TEST(QuitGuard, UnsavedSecondsCountFromTheLastSaveOfTheSameRender) {
+  const ui::SaveMark none;
+  EXPECT_DOUBLE_EQ(ui::unsaved_seconds(none, 3, 12.0), 12.0);
+  const ui::SaveMark saved{3, 10.0};
+  EXPECT_DOUBLE_EQ(ui::unsaved_seconds(saved, 3, 12.5), 2.5);
+  EXPECT_DOUBLE_EQ(ui::unsaved_seconds(saved, 4, 1.0), 1.0);  // another render since: the save was not of it
+  EXPECT_GT(ui::unsaved_seconds(none, 0, ui::kUnsavedAskSeconds + 1.0), ui::kUnsavedAskSeconds);
+}
+
 TEST(Presets, MatchTheBookAndFlagBias) {
   EXPECT_EQ(ui::preset_sampling(ui::Preset::Book5050).strategy().to_string(),
             Strategy::parse("mix:cosine=0.5,light=0.5").to_string());

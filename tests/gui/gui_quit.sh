@@ -1,0 +1,135 @@
+#!/usr/bin/env bash
+# GUI test of Esc and quitting under Xvfb, driven with xdotool: Esc with a
+# drop-down open and with a text field being edited leaves the viewer running
+# (and closes the one, cancels the other); Ctrl+Q after a render of more than
+# a few seconds asks first (Esc cancels, Ctrl+Q again quits); the pixel probe
+# follows a strategy switch (key 2) without a new click.
+#   gui_quit.sh PDFLAB SCENE ARTIFACT_DIR
+# Exit 77 only when xvfb-run itself is missing.
+set -euo pipefail
+
+source "$(dirname "$0")/lib.sh"
+inside_xvfb "1280x800x24" "xdotool import identify compare convert" "$0" "$@"
+shift
+pdflab=$1 scene=$2 art=$3
+rm -rf "$art"
+mkdir -p "$art"
+rmse() { (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p'; }
+# changed A B [FLOOR] / same A B [CEILING]: RMSE (0..1) of two captures.
+changed() {
+  local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") -> $(basename "$2"): RMSE $d"
+  awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d > f) }' || fail "$2 did not change from $1"
+}
+same() {
+  local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") vs $(basename "$2"): RMSE $d"
+  awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d <= f) }' || fail "$2 differs from $1"
+}
+# shot NAME [GEOMETRY]: the window, or a crop of it.
+shot() {
+  import -window "$wid" "$art/$1.png"
+  [ -z "${2:-}" ] || convert "$art/$1.png" -crop "$2" +repage "$art/$1.png"
+}
+
+"$pdflab" --scene "$scene" --strategy cosine &
+viewer=$!
+trap 'kill $viewer 2>/dev/null || true' EXIT
+wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+[ -n "$wid" ] || fail "no viewer window"
+sleep 1
+xdotool windowfocus --sync "$wid"
+xdotool mousemove 2 2
+sleep 0.5
+eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
+px=$((WIDTH - 400))  # the side panel's left edge
+# The panel's top rows: the strategy drop-down, then (below what it covers
+# when open) the scene path field.
+panel_top="390x300+$px+0"
+shot panel "$panel_top"
+
+echo "== Esc with a drop-down open"
+xdotool mousemove "$((px + 120))" 43 click 1
+sleep 0.5
+shot dropdown "$panel_top"
+changed "$art/panel.png" "$art/dropdown.png" 0.03
+xdotool key --window "$wid" Escape
+sleep 0.5
+alive "$viewer" "Esc with a drop-down open"
+xdotool mousemove 2 2
+sleep 0.3
+shot dropdown_closed "$panel_top"
+changed "$art/dropdown.png" "$art/dropdown_closed.png" 0.03
+
+echo "== Esc while editing a text field"
+field="300x22+$((px + 8))+151"
+shot field_before "$field"
+xdotool mousemove "$((px + 200))" 162 click 1
+sleep 0.2
+xdotool key --window "$wid" End
+xdotool type --window "$wid" "xyz"
+sleep 0.3
+shot field_typing "$field"
+changed "$art/field_before.png" "$art/field_typing.png" 0.005
+xdotool key --window "$wid" Escape
+sleep 0.5
+alive "$viewer" "Esc in a text field"
+xdotool mousemove 2 2
+sleep 0.3
+shot field_after "$field"
+# Cancelled: the field shows the path it had (the caret gone).
+same "$art/field_before.png" "$art/field_after.png" 0.02
+
+echo "== the pixel probe follows a strategy switch"
+# The image is centred left of the panel.
+size=$((px < HEIGHT ? px : HEIGHT))
+left=$(((px - size) / 2)) top=$(((HEIGHT - size) / 2))
+xdotool key --window "$wid" p
+sleep 0.3
+xdotool mousemove "$((left + size * 30 / 100))" "$((top + size * 88 / 100))" click 1
+xdotool mousemove 2 2
+sleep 1
+# The probe window's legend (counts per technique, light samples per target).
+legend="230x150+$((WIDTH - 250))+60"
+shot probe_cosine "$legend"
+xdotool key --window "$wid" 2   # preset: light only
+sleep 1
+shot probe_light "$legend"
+changed "$art/probe_cosine.png" "$art/probe_light.png" 0.02
+shot probe_window
+xdotool key --window "$wid" Escape  # leaves probe mode, closes the probe
+sleep 0.5
+alive "$viewer" "Esc in probe mode"
+shot probe_left
+changed "$art/probe_window.png" "$art/probe_left.png" 0.02
+
+echo "== Ctrl+Q after a long unsaved render asks first"
+sleep 6
+xdotool key --window "$wid" ctrl+q
+sleep 1
+alive "$viewer" "Ctrl+Q after an unsaved render (it must ask first)"
+shot asking
+xdotool key --window "$wid" Escape   # cancel
+sleep 0.5
+alive "$viewer" "Esc in the quit question"
+shot cancelled
+changed "$art/asking.png" "$art/cancelled.png" 0.02
+xdotool key --window "$wid" ctrl+q
+sleep 1
+alive "$viewer" "Ctrl+Q (asking again)"
+xdotool key --window "$wid" ctrl+q   # quit anyway
+for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
+kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q twice did not quit"
+wait "$viewer" || fail "viewer exited with status $?"
+trap - EXIT
+
+echo "== a short render quits at once"
+"$pdflab" --scene "$scene" --strategy cosine &
+viewer=$!
+trap 'kill $viewer 2>/dev/null || true' EXIT
+wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+sleep 1
+xdotool key --window "$wid" ctrl+q
+for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
+kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q after one second asked instead of quitting"
+wait "$viewer" || fail "viewer exited with status $?"
+trap - EXIT
+echo "PASS"
