@@ -35,6 +35,8 @@ class TeachingViews {
   void draw_ui(RenderSession& main, const ui::Viewport& image, int framebuffer_height, float framebuffer_scale,
                float area_width, float area_height);
   bool split_active() const { return split_.on; }
+  // A left click on the image means something here (a probe, the divider): it does not pan.
+  bool takes_left_clicks() const { return probe_.mode || split_.on; }
   // The split's state for the side panel; null while it is off.
   const ui::SplitState* split_state() const { return split_.on ? &split_ : nullptr; }
   // Rendering time of the split's longer-running side (0 while it is off).

@@ -7,6 +7,7 @@
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 #include "ui/display.h"
+#include "ui/image_view.h"
 #include "ui/measure_panel.h"
 #include "ui/panels.h"
 #include "ui/screenshot.h"
@@ -125,6 +126,12 @@ struct Viewer::Impl {
   bool quit_asking = false;
   bool quit_after_save = false;
   bool close_popups = false;  // Esc with a drop-down open
+
+  // Looking closely: zoom and pan (framebuffer pixels), the pixel under the cursor.
+  ui::ImageView view;
+  ui::Viewport last_area{};
+  int pan_button = -1;  // the mouse button dragging the image, -1 none
+  std::optional<ui::PixelReadout> inspected;
   std::future<ui::SavedScreenshot> save_job;
   ui::ScreenshotData saving;  // kept until the job reports, for a retry after failure
   std::optional<ui::ScreenshotData> failed_save;
@@ -147,6 +154,8 @@ struct Viewer::Impl {
   void rebuild_fonts();
   void on_key(int key, int mods);
   void on_escape();
+  void navigate(const ui::Viewport& area, int framebuffer_height);
+  void inspect(const ui::ImageRect& image_rect, const ui::ImageRect& area_rect);
   void request_quit();
   double unsaved_seconds() const;
   bool apply_render_settings();
@@ -457,6 +466,22 @@ void Viewer::Impl::on_key(int key, int mods) {
   if (quit_asking) return;
   // Typing a path must not pause the render or restart it.
   if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12) return;
+  if (key == GLFW_KEY_C && (mods & GLFW_MOD_CONTROL)) {
+    // What the inspector shows, as text: for notes, and for tests to compare with the PFM.
+    if (inspected) glfwSetClipboardString(window, inspected->text().c_str());
+    return;
+  }
+  const int w = image_info.width, h = image_info.height;
+  const double cx = last_area.x + last_area.width * 0.5, cy = last_area.y + last_area.height * 0.5;
+  switch (key) {
+    case GLFW_KEY_F: view.fit = true; return;
+    case GLFW_KEY_Z: view.actual_size(last_area, w, h); return;
+    case GLFW_KEY_EQUAL:
+    case GLFW_KEY_KP_ADD: view.zoom_about(last_area, w, h, 2.0, cx, cy); return;
+    case GLFW_KEY_MINUS:
+    case GLFW_KEY_KP_SUBTRACT: view.zoom_about(last_area, w, h, 0.5, cx, cy); return;
+    default: break;
+  }
   if (teaching->on_key(key, *session, settings.paused)) return;
   switch (key) {
     case GLFW_KEY_SPACE:
@@ -482,6 +507,58 @@ void Viewer::Impl::on_key(int key, int mods) {
     case GLFW_KEY_F1: panel.show_help = !panel.show_help; break;
     default: break;
   }
+}
+
+void Viewer::Impl::navigate(const ui::Viewport& area, int framebuffer_height) {
+  // Mouse over the image area and not over a window: the wheel zooms about the
+  // cursor; dragging pans (right or middle button always, left unless a click
+  // means something else there: probe mode, the split's divider).
+  last_area = area;
+  const ImGuiIO& io = ImGui::GetIO();
+  const double fbs = framebuffer_scale;
+  const double mx = io.MousePos.x * fbs, my = framebuffer_height - io.MousePos.y * fbs;
+  const bool over = !io.WantCaptureMouse && mx >= area.x && mx < area.x + area.width && my >= area.y &&
+                    my < area.y + area.height;
+  const int w = image_info.width, h = image_info.height;
+  if (over && io.MouseWheel != 0.0f) view.zoom_about(area, w, h, std::pow(1.25, io.MouseWheel), mx, my);
+  if (pan_button >= 0 && !ImGui::IsMouseDown(pan_button)) pan_button = -1;
+  if (pan_button < 0 && over) {
+    for (int b : {ImGuiMouseButton_Right, ImGuiMouseButton_Middle, ImGuiMouseButton_Left}) {
+      if (b == ImGuiMouseButton_Left && teaching->takes_left_clicks()) continue;
+      if (ImGui::IsMouseClicked(b)) pan_button = b;
+    }
+  }
+  // A left click that does not move is no pan (nothing else happens either).
+  if (pan_button >= 0 && (pan_button != ImGuiMouseButton_Left || ImGui::IsMouseDragging(pan_button)))
+    view.pan(area, w, h, io.MouseDelta.x * fbs, -io.MouseDelta.y * fbs);
+}
+
+void Viewer::Impl::inspect(const ui::ImageRect& image_rect, const ui::ImageRect& area_rect) {
+  // The pixel under the cursor, read from the image on screen (not in the split:
+  // its sides are other images).
+  inspected.reset();
+  const ImGuiIO& io = ImGui::GetIO();
+  if (io.WantCaptureMouse || teaching->split_active() || settings.measure.view_mode != ui::ViewMode::Image) return;
+  const float mx = io.MousePos.x, my = io.MousePos.y;
+  if (mx < area_rect.x || my < area_rect.y || mx >= area_rect.x + area_rect.width || my >= area_rect.y + area_rect.height)
+    return;
+  const auto hit = ui::pixel_at(mx, my, image_rect.x, image_rect.y, image_rect.width, image_rect.height,
+                                image_info.width, image_info.height);
+  if (!hit) return;
+  inspected = ui::read_pixel(measure.published, measure.reference.loaded() ? &measure.reference : nullptr, hit->x,
+                             hit->y);
+  if (!inspected) return;
+  ImGui::SetNextWindowPos(ImVec2(area_rect.x + area_rect.width - 8.0f, area_rect.y + area_rect.height - 8.0f),
+                          ImGuiCond_Always, ImVec2(1.0f, 1.0f));
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+  if (ImGui::Begin("##inspector", nullptr, flags)) {
+    ImGui::TextUnformatted(inspected->text().c_str());
+    ImGui::TextColored(ImVec4(0.65f, 0.65f, 0.68f, 1.0f), "Ctrl+C copies. Wheel: zoom,\ndrag: pan, Z: 1:1, F: fit");
+  }
+  ImGui::End();
 }
 
 void Viewer::Impl::pull_image() {
@@ -669,24 +746,27 @@ bool Viewer::frame(bool paced, bool force_draw) {
   v.fill_status();
   const ImGuiIO& io = ImGui::GetIO();
   const float panel_width = std::min(kPanelWidth * v.content_scale / v.framebuffer_scale, io.DisplaySize.x);
+  const float fbs = v.framebuffer_scale;
+  const int panel_px = static_cast<int>(panel_width * fbs);
+  const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
+  v.navigate(area, fb_h);
+  // The image's place, in framebuffer pixels and in ImGui coordinates for what is drawn over it.
+  const ui::Viewport image_fb = v.view.place(area, v.image_info.width, v.image_info.height);
+  const ui::ImageRect image_rect{static_cast<float>(image_fb.x) / fbs,
+                                 static_cast<float>(fb_h - image_fb.y - image_fb.height) / fbs,
+                                 static_cast<float>(image_fb.width) / fbs, static_cast<float>(image_fb.height) / fbs};
+  const ui::ImageRect area_rect{0.0f, 0.0f, io.DisplaySize.x - panel_width, io.DisplaySize.y};
+  // Layers, the divider, the probe's cross: never over the panel, however far the image reaches.
+  ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(area_rect.x, area_rect.y),
+                                               ImVec2(area_rect.x + area_rect.width, area_rect.y + area_rect.height));
   ui::UiRequests requests;
   ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
   ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
   ui::draw_image_badges(v.settings, v.status);
-  {
-    // The image's place in ImGui coordinates, for the layers and plot drawn over it.
-    const float fbs = v.framebuffer_scale;
-    const int panel_fb = static_cast<int>(panel_width * fbs);
-    const ui::Viewport image_fb =
-        ui::fit_image({0, 0, std::max(0, fb_w - panel_fb), fb_h}, v.image_info.width, v.image_info.height);
-    const ui::ImageRect image_rect{static_cast<float>(image_fb.x) / fbs,
-                                   static_cast<float>(fb_h - image_fb.y - image_fb.height) / fbs,
-                                   static_cast<float>(image_fb.width) / fbs, static_cast<float>(image_fb.height) / fbs};
-    const ui::ImageRect area_rect{0.0f, 0.0f, io.DisplaySize.x - panel_width, io.DisplaySize.y};
-    ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
-    v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, io.DisplaySize.x - panel_width,
-                        io.DisplaySize.y);
-  }
+  ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
+  v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, area_rect.width, area_rect.height);
+  v.inspect(image_rect, area_rect);
+  ImGui::GetBackgroundDrawList()->PopClipRect();
   if (v.quit_asking) {
     switch (ui::draw_quit_dialog(v.unsaved_seconds(), v.quit_after_save || v.save_job.valid(), v.status.notice)) {
       case ui::QuitChoice::SaveAndQuit:
@@ -718,20 +798,19 @@ bool Viewer::frame(bool paced, bool force_draw) {
   glViewport(0, 0, fb_w, fb_h);
   glClearColor(0.05f, 0.05f, 0.055f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
-  const int panel_px = static_cast<int>(panel_width * v.framebuffer_scale);
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(fb_w - panel_px, 0, panel_px, fb_h);
-  glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  glDisable(GL_SCISSOR_TEST);
-  const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
   if (v.teaching->split_active())
-    v.teaching->draw_split_image(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
-                                 v.settings.srgb);
+    v.teaching->draw_split_image(image_fb, v.settings.exposure_ev, v.settings.srgb);
   else
-    v.display->draw(ui::fit_image(area, v.image_info.width, v.image_info.height), v.settings.exposure_ev,
-                    v.settings.srgb);
+    v.display->draw(image_fb, v.settings.exposure_ev, v.settings.srgb);
   glViewport(0, 0, fb_w, fb_h);
+  // The panel's background after the image: a zoomed image reaching past its area is cut there.
+  if (panel_px > 0) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(fb_w - panel_px, 0, panel_px, fb_h);
+    glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+  }
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   glfwSwapBuffers(v.window);
 

@@ -2,6 +2,7 @@
 // names and failures, image placement. No window needed.
 #include "renderer/error.h"
 #include "ui/display.h"
+#include "ui/image_view.h"
 #include "ui/screenshot.h"
 #include "ui/settings.h"
 
@@ -57,6 +58,82 @@ TEST(SamplingSettings, AllZeroWeightsNormaliseToZero) {
   ui::SamplingSettings s;
   s.mixture = true;
   for (float w : s.normalised()) EXPECT_EQ(w, 0.0f);
+}
+
+TEST(ImageView, ZoomKeepsThePointUnderTheCursorAndOneToOneIsWholePixels) {
+  const ui::Viewport area{0, 0, 400, 300};
+  ui::ImageView v;
+  const ui::Viewport fitted = v.place(area, 100, 100);
+  EXPECT_EQ(fitted.width, 300);
+  // The image point under (150, 100) before and after zooming by 2.5.
+  const auto image_point = [&](const ui::Viewport& p, double x, double y) {
+    return std::pair{(x - p.x) * 100.0 / p.width, (y - p.y) * 100.0 / p.height};
+  };
+  const auto before = image_point(fitted, 150, 100);
+  v.zoom_about(area, 100, 100, 2.5, 150, 100);
+  EXPECT_FALSE(v.fit);
+  const ui::Viewport zoomed = v.place(area, 100, 100);
+  EXPECT_EQ(zoomed.width, 750);
+  const auto after = image_point(zoomed, 150, 100);
+  EXPECT_NEAR(before.first, after.first, 0.01);
+  EXPECT_NEAR(before.second, after.second, 0.01);
+  v.pan(area, 100, 100, 10, -4);
+  EXPECT_EQ(v.place(area, 100, 100).x, zoomed.x + 10);
+  EXPECT_EQ(v.place(area, 100, 100).y, zoomed.y - 4);
+  v.zoom_about(area, 100, 100, 1e9, 0, 0);
+  EXPECT_DOUBLE_EQ(v.zoom, ui::ImageView::kMaxZoom);
+  v.actual_size(area, 101, 100);
+  const ui::Viewport one = v.place(area, 101, 100);
+  EXPECT_EQ(one.width, 101);
+  EXPECT_EQ(one.height, 100);
+  EXPECT_EQ(one.x, 149);
+  EXPECT_EQ(one.y, 100);
+  v.fit = true;
+  EXPECT_EQ(v.place(area, 100, 100).width, fitted.width);
+}
+
+TEST(PixelInspector, ReadsThePublishedPixelItsNoiseAndTheReference) {
+  PublishedImage img;
+  img.info.width = img.info.data_width = 3;
+  img.info.height = img.info.data_height = 2;
+  img.info.spp = 16;
+  img.rgb.resize(18);
+  for (std::size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = 0.1f * static_cast<float>(i);
+  img.relative_standard_error = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
+  const auto r = ui::read_pixel(img, nullptr, 2, 1);  // the last pixel
+  ASSERT_TRUE(r);
+  EXPECT_FLOAT_EQ(r->rgb[0], img.rgb[15]);
+  EXPECT_FLOAT_EQ(r->rgb[2], img.rgb[17]);
+  EXPECT_FLOAT_EQ(static_cast<float>(r->relative_standard_error), 0.6f);
+  EXPECT_NEAR(r->luminance, 0.2126 * img.rgb[15] + 0.7152 * img.rgb[16] + 0.0722 * img.rgb[17], 1e-6);
+  EXPECT_FALSE(r->has_reference);
+  EXPECT_FALSE(ui::read_pixel(img, nullptr, 3, 0));
+  EXPECT_FALSE(ui::read_pixel(img, nullptr, 0, -1));
+  // The text shows what the PFM holds, %g with six digits.
+  EXPECT_NE(r->text().find("RGB  1.5 1.6 1.7"), std::string::npos) << r->text();
+
+  ui::ReferenceImage ref;
+  ref.width = 3;
+  ref.height = 2;
+  ref.rgb.assign(18, 1.0f);
+  const auto with_ref = ui::read_pixel(img, &ref, 2, 1);
+  ASSERT_TRUE(with_ref && with_ref->has_reference);
+  EXPECT_FLOAT_EQ(with_ref->reference[1], 1.0f);
+  ref.width = 2;  // another size: not comparable
+  EXPECT_FALSE(ui::read_pixel(img, &ref, 2, 1)->has_reference);
+
+  // A preview: one value per 2x2 block, no noise figure.
+  PublishedImage preview;
+  preview.info.width = 4;
+  preview.info.height = 4;
+  preview.info.data_width = preview.info.data_height = 2;
+  preview.info.preview_scale = 2;
+  preview.info.preview = true;
+  preview.rgb = {0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3};
+  const auto p = ui::read_pixel(preview, nullptr, 3, 2);
+  ASSERT_TRUE(p);
+  EXPECT_FLOAT_EQ(p->rgb[0], 3.0f);
+  EXPECT_LT(p->relative_standard_error, 0.0);
 }
 
 TEST(QuitGuard, UnsavedSecondsCountFromTheLastSaveOfTheSameRender) {
