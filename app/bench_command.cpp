@@ -1,5 +1,7 @@
 #include "app/bench_command.h"
 
+#include "app/reference_command.h"
+
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
@@ -21,13 +23,14 @@ namespace {
 
 struct Checkpoint {
   std::uint32_t spp;
-  double seconds, rmse, relmse;
+  double seconds, rmse, relmse, relmse_raw;  // relmse: corrected for the reference's noise
 };
 
 struct Result {
   Strategy strategy;
   std::uint32_t spp = 0;
-  double seconds = 0, rmse = 0, relmse = 0, efficiency = 0, samples_per_second = 0;
+  double seconds = 0, rmse = 0, efficiency = 0, samples_per_second = 0;
+  RelMseMeasure error;  // relmse: error.corrected
   double estimated_relmse = 0;  // the film's own prediction, for comparison with the measured relmse
   std::uint64_t dropped = 0;
   std::vector<Checkpoint> curve;
@@ -50,7 +53,7 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, const BenchOptions& o,
-               const std::vector<float>& reference, const std::string& progress_prefix, bool show_progress) {
+               const Reference& reference, const std::string& progress_prefix, bool show_progress) {
   RenderSession session(o.threads);
   RenderSettings settings;
   settings.scene = scene;
@@ -68,8 +71,10 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
     SessionStats st = session.stats();
     ImageInfo info;
     // The info describes the very image copied (its pass's spp and time); previews are not estimates.
-    if (session.copy_image(image, info, version) && !info.preview && info.spp > 0)
-      r.curve.push_back({info.spp, info.seconds, rmse(image, reference), relmse(image, reference)});
+    if (session.copy_image(image, info, version) && !info.preview && info.spp > 0) {
+      const RelMseMeasure m = measure_relmse(image, reference.rgb, reference.variance);
+      r.curve.push_back({info.spp, info.seconds, rmse(image, reference.rgb), m.corrected, m.raw});
+    }
     if (show_progress) {
       const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
       std::fprintf(stderr, "\r%s %-32s %5.1f%%  %u spp  %.1f s   ", progress_prefix.c_str(),
@@ -87,29 +92,18 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   const std::vector<float> final_image = film.mean_rgb();
   r.spp = st.spp;
   r.seconds = st.seconds;
-  r.rmse = rmse(final_image, reference);
-  r.relmse = relmse(final_image, reference);
-  r.efficiency = efficiency(r.relmse, r.seconds);
+  r.rmse = rmse(final_image, reference.rgb);
+  r.error = measure_relmse(final_image, reference.rgb, reference.variance);
+  r.efficiency = efficiency(r.error.corrected, r.seconds);
   r.estimated_relmse = estimated_relmse(film);
   r.samples_per_second = st.samples_per_second;
   r.dropped = st.dropped.total();
-  if (r.curve.empty() || r.curve.back().spp != r.spp) r.curve.push_back({r.spp, r.seconds, r.rmse, r.relmse});
+  if (r.curve.empty() || r.curve.back().spp != r.spp)
+    r.curve.push_back({r.spp, r.seconds, r.rmse, r.error.corrected, r.error.raw});
   return r;
 }
 
 }  // namespace
-
-// A reference with NaN or infinity would turn every error into NaN and rank
-// the strategies at random; say where the first bad value is instead.
-void check_reference(const std::string& path, const std::vector<float>& rgb, int width) {
-  std::size_t bad = 0, first = 0;
-  for (std::size_t i = 0; i < rgb.size(); ++i)
-    if (!std::isfinite(rgb[i]) && bad++ == 0) first = i;
-  if (bad == 0) return;
-  const std::size_t pixel = first / 3, w = static_cast<std::size_t>(width);
-  throw InputError("reference '" + path + "' has " + std::to_string(bad) + " values that are not finite (first at pixel " +
-                   std::to_string(pixel % w) + "," + std::to_string(pixel / w) + ")");
-}
 
 int run_bench(const BenchOptions& o) {
   if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
@@ -123,12 +117,29 @@ int run_bench(const BenchOptions& o) {
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
-  int rw = 0, rh = 0;
-  const std::vector<float> reference = read_pfm(o.reference, rw, rh);
-  check_reference(o.reference, reference, rw);
-  scene->camera.width = rw;
-  scene->camera.height = rh;
-  scene->prepare();
+  Reference reference;
+  if (o.reference == "auto") {
+    if (o.width) scene->camera.width = o.width;
+    if (o.height) scene->camera.height = o.height;
+    check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
+    scene->prepare();
+    reference = resolve_reference(o.reference, *scene, o.scene, o.cache_dir, true, o.quiet);
+  } else {
+    if (o.width || o.height) throw InputError("--width/--height go with --reference auto; a file's size is its own");
+    reference = load_reference(o.reference);  // InputError: unreadable, truncated, not finite
+    scene->camera.width = reference.width;
+    scene->camera.height = reference.height;
+    scene->prepare();
+  }
+  // Decorrelation: no run may repeat the reference's random numbers.
+  for (const Strategy& s : strategies)
+    if (const std::string shared = shared_random_numbers(reference.info, o.seed, s); !shared.empty())
+      throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  if (!o.quiet && !reference.has_variance())
+    std::fprintf(stderr,
+                 "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "
+                 "(make one with pdflab reference)\n",
+                 reference.path.c_str());
 
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
   if (!o.quiet)
@@ -149,21 +160,26 @@ int run_bench(const BenchOptions& o) {
   // can leave one file without the others.
   // est_relmse: what the film predicts without a reference; unbiased: 0 for a
   // strategy whose pdf misses directions the integrand needs.
-  std::string csv = "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased\n";
+  // relmse is corrected for the reference's own noise, relmse_raw is not;
+  // relmse_ci: 95% half width of relmse; ref_share: the reference's part of relmse_raw.
+  std::string csv =
+      "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased,relmse_raw,"
+      "relmse_ci,ref_share\n";
   char line[512];
   for (const Result& r : results) {
-    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d\n", r.spp, r.seconds, r.rmse, r.relmse,
-                  r.efficiency, r.samples_per_second, static_cast<unsigned long long>(r.dropped), r.estimated_relmse,
-                  r.strategy.is_unbiased() ? 1 : 0);
+    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g\n", r.spp, r.seconds,
+                  r.rmse, r.error.corrected, r.efficiency, r.samples_per_second,
+                  static_cast<unsigned long long>(r.dropped), r.estimated_relmse, r.strategy.is_unbiased() ? 1 : 0,
+                  r.error.raw, r.error.interval, r.error.reference_share());
     csv += csv_field(r.strategy.to_string()) + line;
   }
 
   std::string curves;
   if (!o.curves.empty()) {
-    curves = "strategy,spp,seconds,rmse,relmse\n";
+    curves = "strategy,spp,seconds,rmse,relmse,relmse_raw\n";
     for (const Result& r : results)
       for (const Checkpoint& k : r.curve) {
-        std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse);
+        std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse, k.relmse_raw);
         curves += csv_field(r.strategy.to_string()) + line;
       }
   }
@@ -195,17 +211,21 @@ int run_bench(const BenchOptions& o) {
   if (!o.plot.empty()) write_text(o.plot, plot);
 
   // The table: efficiency relative to the first strategy says which PDF wins.
-  std::printf("%-36s %7s %8s %10s %10s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse", "relmse",
-              "est relmse", "efficiency", "vs first", "Msamp/s", "dropped");
+  std::printf("%-36s %7s %8s %10s %10s %9s %10s %7s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse",
+              "relmse", "+-", "raw", "ref %", "est relmse", "efficiency", "vs first", "Msamp/s", "dropped");
   for (const Result& r : results) {
     const double ratio = results[0].efficiency > 0 ? r.efficiency / results[0].efficiency : 0.0;
-    std::printf("%-36s %7u %8.2f %10.4g %10.4g %10.4g %11.4g %7.2fx %9.3f %8llu%s\n", r.strategy.to_string().c_str(),
-                r.spp, r.seconds, r.rmse, r.relmse, r.estimated_relmse, r.efficiency, ratio, r.samples_per_second * 1e-6,
-                static_cast<unsigned long long>(r.dropped), r.strategy.is_unbiased() ? "" : "  (biased)");
+    std::printf("%-36s %7u %8.2f %10.4g %10.4g %9.2g %10.4g %6.1f%% %10.4g %11.4g %7.2fx %9.3f %8llu%s\n",
+                r.strategy.to_string().c_str(), r.spp, r.seconds, r.rmse, r.error.corrected, r.error.interval,
+                r.error.raw, 100.0 * r.error.reference_share(), r.estimated_relmse, r.efficiency, ratio,
+                r.samples_per_second * 1e-6, static_cast<unsigned long long>(r.dropped),
+                r.strategy.is_unbiased() ? "" : "  (biased)");
   }
-  std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e); efficiency = 1 / (relMSE * seconds); est relmse: the "
-              "film's own prediction, no reference\n",
-              kRelMseEpsilon);
+  std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e) %s, +- its 95%% interval; raw: uncorrected; ref %%: the "
+              "reference's own noise as a share of raw; efficiency = 1 / (relMSE * seconds); est relmse: the film's "
+              "own prediction, no reference\n",
+              kRelMseEpsilon,
+              reference.has_variance() ? "minus the reference's own noise" : "(the reference has no variance: uncorrected)");
   return 0;
 }
 

@@ -9,7 +9,9 @@ struct BenchOptions {
   std::string strategies;  // "S1;S2;..."
   double seconds = 0.0;    // equal time per strategy (or)
   std::uint32_t spp = 0;   // equal samples per pixel
-  std::string reference;   // PFM; its size sets the render size
+  std::string reference;   // PFM (its size sets the render size) or "auto" (the cache)
+  int width = 0, height = 0;  // with "auto": the size to look up (0: the scene's)
+  std::string cache_dir;      // empty: reference_cache_dir()
   std::string csv;
   std::string plot;        // SVG, optional
   std::string curves;      // CSV of every checkpoint, optional

@@ -1,6 +1,7 @@
 // pdflab: the viewer (default) and the headless commands. See INTERFACE.md / README.md.
 #include "app/assets.h"
 #include "app/bench_command.h"
+#include "app/reference_command.h"
 #include "app/render_command.h"
 #include "renderer/error.h"
 
@@ -30,6 +31,20 @@ int report_input_error(const std::string& what) {
 
 // CLI11 wraps "-1" around and saturates a too large number when it converts
 // them to an unsigned option; both are typing mistakes, so check first.
+// CLI::PositiveNumber would print DBL_MAX in its message and let "nan" through;
+// say plainly what is wrong instead.
+CLI::Validator positive_number(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0)
+          return "must be a positive number" + what + ", not '" + text + "'";
+        return std::string();
+      },
+      "NUMBER");
+}
+
 CLI::Validator non_negative_integer() {
   return CLI::Validator(
       [](std::string& value) {
@@ -76,7 +91,34 @@ int main(int argc, char** argv) {
   render->add_option("--stats-json", ro.stats_json, "Also write the summary as JSON");
   render->add_option("--transfer", ro.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
       ->check(CLI::IsMember({"gamma2", "srgb"}));
+  render->add_option("--reference", ro.reference,
+                     "Reference to measure against: a .pfm, or 'auto' for the cached one of this scene, size and depth");
+  render->add_option("--cache-dir", ro.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
+                                                  "else $XDG_CACHE_HOME/pdflab/references)");
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
+
+  pdflab::ReferenceOptions fo;
+  CLI::App* reference = app.add_subcommand(
+      "reference", "Render a converged reference (unbiased, reserved seeds) into the cache, and --out if given");
+  reference->add_option("--scene", fo.scene, "Scene file (JSON)")->required();
+  reference->add_option("--width", fo.width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
+  reference->add_option("--height", fo.height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
+  reference->add_option("--max-depth", fo.max_depth, "Path depth (default: the scene's)")->check(CLI::Range(1, 10000));
+  reference->add_option("--spp", fo.spp, "Stop at this many samples per pixel")->check(CLI::Range(1u, 1u << 30));
+  reference->add_option("--seconds", fo.seconds, "Stop after this much rendering time")
+      ->check(positive_number(" of seconds"));
+  reference->add_option("--target-relmse", fo.target_relmse,
+                        "Stop when the estimated relMSE of the reference itself is at most this")
+      ->check(positive_number(""));
+  reference->add_option("--strategy", fo.strategy,
+                        "Unbiased strategy (default: mix:cosine=0.5,light=0.5, cosine for a scene without targets)");
+  reference->add_option("--seed-stream", fo.seed_stream, "Which of the reference seeds (independent references)")
+      ->check(CLI::Range(0u, 1u << 30));
+  reference->add_option("--out", fo.out, "Also write the reference here (.pfm, with .var.pfm and .json beside it)");
+  reference->add_option("--cache-dir", fo.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
+                                                     "else $XDG_CACHE_HOME/pdflab/references)");
+  reference->add_option("--threads", fo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  reference->add_flag("--quiet", fo.quiet, "No progress bar or notes");
 
   pdflab::BenchOptions bo;
   CLI::App* bench = app.add_subcommand("bench", "Compare strategies at equal time (or spp) against a reference");
@@ -85,17 +127,17 @@ int main(int argc, char** argv) {
   // CLI::PositiveNumber would print DBL_MAX in its message and let "nan" through to the
   // "exactly one of" check; say plainly what is wrong instead.
   bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            char* end = nullptr;
-            const double v = std::strtod(text.c_str(), &end);
-            if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0)
-              return "must be a positive number of seconds, not '" + text + "'";
-            return std::string();
-          },
-          "SECONDS"));
+      ->check(positive_number(" of seconds"));
   bench->add_option("--spp", bo.spp, "Samples per pixel per strategy (equal samples)")->check(CLI::Range(1u, 1u << 30));
-  bench->add_option("--reference", bo.reference, "Reference image (PFM; its size sets the render size)")->required();
+  bench->add_option("--reference", bo.reference,
+                    "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
+      ->required();
+  bench->add_option("--width", bo.width, "With --reference auto: image width (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  bench->add_option("--height", bo.height, "With --reference auto: image height (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  bench->add_option("--cache-dir", bo.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
+                                                 "else $XDG_CACHE_HOME/pdflab/references)");
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
   bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
@@ -120,6 +162,7 @@ int main(int argc, char** argv) {
   try {
     if (render->parsed()) return pdflab::run_render(ro);
     if (bench->parsed()) return pdflab::run_bench(bo);
+    if (reference->parsed()) return pdflab::run_reference(fo);
 #ifdef PDFLAB_HAVE_VIEWER
     pdflab::ViewerOptions vo;
     vo.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;

@@ -1,5 +1,8 @@
 #include "app/render_command.h"
 
+#include "app/reference_command.h"
+#include "renderer/metrics/metrics.h"
+
 #include "renderer/error.h"
 #include "renderer/film/film.h"
 #include "renderer/film/image_io.h"
@@ -53,6 +56,19 @@ int run_render(const RenderOptions& o) {
   const Strategy strategy = Strategy::parse(o.strategy);
   (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
 
+  // The reference is checked before any rendering: its size, and that the
+  // render would not repeat its random numbers.
+  const Reference reference = resolve_reference(o.reference, *scene, o.scene, o.cache_dir, false, o.quiet);
+  if (reference.loaded()) {
+    if (reference.width != scene->camera.width || reference.height != scene->camera.height)
+      throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
+                       std::to_string(reference.height) + " but the render is " +
+                       std::to_string(scene->camera.width) + "x" + std::to_string(scene->camera.height) +
+                       " (use --width/--height)");
+    if (const std::string shared = shared_random_numbers(reference.info, o.seed, strategy); !shared.empty())
+      throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  }
+
   if (!strategy.is_unbiased() && !o.quiet)
     std::fprintf(stderr,
                  "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
@@ -68,8 +84,15 @@ int run_render(const RenderOptions& o) {
   session.set_settings(settings);
 
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
-  while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 1000)))
+  EstimateHistory history;  // is the film's own estimate trustworthy?
+  std::vector<float> pass_image;
+  std::uint64_t pass_version = 0;
+  while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
     if (show_progress) draw_progress(session.stats(), o.spp);
+    ImageInfo info;
+    if (session.copy_image(pass_image, info, pass_version) && !info.preview)
+      history.add(info.spp, info.estimated_relmse);
+  }
   const SessionStats st = session.stats();
   if (show_progress) {
     draw_progress(st, o.spp);
@@ -77,7 +100,13 @@ int run_render(const RenderOptions& o) {
   }
 
   const Film film = session.copy_film();
-  write_image(o.out, film.mean_rgb(), film.width(), film.height(), transfer);
+  const std::vector<float> mean = film.mean_rgb();
+  const double estimate = estimated_relmse(film);
+  history.add(st.spp, estimate);
+  write_image(o.out, mean, film.width(), film.height(), transfer);
+  RelMseMeasure error;
+  if (reference.loaded()) error = measure_relmse(mean, reference.rgb, reference.variance);
+  const double measured_efficiency = efficiency(error.corrected, st.seconds);
 
   const auto& d = st.dropped.by_reason;
   if (!o.stats_json.empty()) {
@@ -98,6 +127,19 @@ int run_render(const RenderOptions& o) {
     for (int r = 0; r < kDropReasonCount; ++r)
       j["dropped"][std::string(drop_reason_name(static_cast<DropReason>(r)))] = d[r];
     j["output"] = o.out;
+    // The film's own estimate is a lower bound: it cannot see what the samples never found.
+    j["est_relmse"] = estimate;
+    j["est_relmse_unreliable"] = history.unreliable();
+    if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(estimate, st.seconds);
+    if (reference.loaded()) {
+      j["reference"] = reference.path;
+      j["relmse"] = error.corrected;
+      j["relmse_interval"] = error.interval;
+      j["relmse_raw"] = error.raw;
+      j["reference_corrected"] = error.reference_corrected;
+      j["reference_share"] = error.reference_share();
+      j["efficiency"] = measured_efficiency;
+    }
     const std::string text = j.dump(2) + "\n";
     write_file_atomic(o.stats_json, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
   }
@@ -107,6 +149,25 @@ int run_render(const RenderOptions& o) {
               st.spp, film.width(), film.height(), st.seconds, st.samples_per_second * 1e-6, session.thread_count(),
               static_cast<unsigned long long>(st.dropped.total()), static_cast<unsigned long long>(d[0]),
               static_cast<unsigned long long>(d[1]), static_cast<unsigned long long>(d[2]), o.out.c_str());
+  if (reference.loaded()) {
+    std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
+                "efficiency %.4g\n",
+                error.corrected, error.interval, reference.path.c_str(), error.raw, 100.0 * error.reference_share(),
+                error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
+                measured_efficiency);
+  } else {
+    std::printf("est. relMSE %.4g: a lower bound from the film's own variance, blind to what its samples never "
+                "found; ",
+                estimate);
+    if (strategy.is_unbiased())
+      std::printf("efficiency estimate %.4g\n", efficiency(estimate, st.seconds));
+    else
+      std::printf("no efficiency: '%s' is biased and no reference shows how much light it misses\n",
+                  strategy.to_string().c_str());
+    if (history.unreliable())
+      std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
+                  "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
+  }
   return 0;
 }
 

@@ -14,6 +14,8 @@ struct RenderOptions {
   int width = 0, height = 0;  // 0: the scene's own
   std::string stats_json;
   std::string transfer = "gamma2";
+  std::string reference;  // optional: a PFM or "auto" (the cache) to measure against
+  std::string cache_dir;  // empty: reference_cache_dir()
   bool quiet = false;
 };
 

@@ -200,8 +200,8 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   EXPECT_EQ(dropped.at("total").get<std::uint64_t>(), sum);
   EXPECT_LE(sum, 32u * 32u * 4u);
 
-  // The one-line summary carries the same numbers.
-  static const std::regex summary(R"(^4 spp, 32x32, [0-9.]+ s, [0-9.]+ M samples/s, 2 threads, [0-9]+ samples dropped.*\n$)");
+  // The one-line summary carries the same numbers; the figures follow on their own line.
+  static const std::regex summary(R"(^4 spp, 32x32, [0-9.]+ s, [0-9.]+ M samples/s, 2 threads, [0-9]+ samples dropped[^\n]*\nest\. relMSE [^\n]*\n$)");
   EXPECT_TRUE(std::regex_search(r.out, summary)) << "stdout: " << r.out;
   EXPECT_NE(r.out.find(", " + std::to_string(sum) + " samples dropped"), std::string::npos) << r.out;
 }

@@ -1,5 +1,6 @@
 #include "renderer/metrics/metrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -35,6 +36,77 @@ double relmse(const std::vector<float>& image, const std::vector<float>& referen
     sum += d * d / (r * r + epsilon);
   }
   return sum / static_cast<double>(image.size());
+}
+
+RelMseMeasure measure_relmse(const std::vector<float>& image, const std::vector<float>& reference,
+                             const std::vector<float>& reference_variance, const std::vector<float>& image_variance,
+                             double epsilon) {
+  check_sizes(image, reference);
+  const bool with_ref_var = !reference_variance.empty();
+  const bool with_image_var = !image_variance.empty();
+  if (with_ref_var) check_sizes(reference_variance, reference);
+  if (with_image_var) check_sizes(image_variance, image);
+  const std::size_t pixels = image.size() / 3;
+  double raw = 0.0, ref_noise = 0.0, img_noise = 0.0;
+  double t_sum = 0.0, t_sq = 0.0, e_sum = 0.0, e_sq = 0.0;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    double d2 = 0.0, vr = 0.0, vx = 0.0;
+    for (std::size_t c = 3 * p; c < 3 * p + 3; ++c) {
+      const double r = reference[c];
+      const double w = 1.0 / (r * r + epsilon);
+      const double d = static_cast<double>(image[c]) - r;
+      d2 += d * d * w;
+      if (with_ref_var) vr += reference_variance[c] * w;
+      if (with_image_var) vx += image_variance[c] * w;
+    }
+    d2 /= 3.0;
+    vr /= 3.0;
+    vx /= 3.0;
+    raw += d2;
+    ref_noise += vr;
+    img_noise += vx;
+    const double t = d2 - vr, e = t - vx;
+    t_sum += t;
+    t_sq += t * t;
+    e_sum += e;
+    e_sq += e * e;
+  }
+  const double n = static_cast<double>(pixels);
+  // 1.96 standard errors of a mean over n terms, from their sample variance.
+  const auto half_width = [n](double sum, double sq) {
+    if (n < 2.0) return 0.0;
+    const double mean = sum / n;
+    const double var = std::max(0.0, (sq / n - mean * mean) * n / (n - 1.0));
+    return 1.96 * std::sqrt(var / n);
+  };
+  RelMseMeasure m;
+  m.raw = raw / n;
+  m.reference_corrected = with_ref_var;
+  m.reference_noise = ref_noise / n;
+  m.corrected = t_sum / n;
+  m.interval = half_width(t_sum, t_sq);
+  if (with_image_var) {
+    m.has_excess = true;
+    m.image_noise = img_noise / n;
+    m.excess = e_sum / n;
+    m.excess_interval = half_width(e_sum, e_sq);
+  }
+  return m;
+}
+
+void EstimateHistory::add(std::uint32_t spp, double estimated_relmse) {
+  if (spp < 2 || !(estimated_relmse > 0.0) || !std::isfinite(estimated_relmse)) return;
+  if (!points_.empty() && spp <= points_.back().first) return;
+  const double per_sample = estimated_relmse * spp;
+  // The latest point at half the samples or fewer.
+  for (auto it = points_.rbegin(); it != points_.rend(); ++it)
+    if (2 * static_cast<std::uint64_t>(it->first) <= spp) {
+      growth_ = per_sample / it->second;
+      if (growth_ > kGrowthLimit) unreliable_ = true;
+      break;
+    }
+  // Points 2% apart in spp at least: a long render keeps a few hundred.
+  if (points_.empty() || static_cast<double>(spp) >= 1.02 * points_.back().first) points_.emplace_back(spp, per_sample);
 }
 
 double efficiency(double relmse_value, double seconds) {

@@ -3,6 +3,8 @@
 // it is by its own account, and what that costs in time.
 #include "renderer/film/film.h"
 
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace pdflab {
@@ -17,9 +19,56 @@ double rmse(const std::vector<float>& image, const std::vector<float>& reference
 double relmse(const std::vector<float>& image, const std::vector<float>& reference,
               double epsilon = kRelMseEpsilon);
 
+// relMSE against a reference that is itself noisy. With r = mu + e_r, the
+// expected (x - r)^2 is (x - mu)^2 + Var(r): a noisy reference adds its own
+// variance to every pixel's error. Subtracting the reference's estimated
+// variance of the mean leaves an unbiased estimate of the error against the
+// true image (docs/measuring.md). Each pixel's term is
+//   t_p = mean over channels of ((x - r)^2 - v_r) / (r^2 + epsilon)
+// and the interval is 1.96 standard errors of their mean over pixels (pixels
+// are independent: each has its own random numbers).
+struct RelMseMeasure {
+  double raw = 0.0;        // mean (x - r)^2 / (r^2 + eps), as relmse()
+  double corrected = 0.0;  // raw minus the reference's noise; may dip below 0 by chance
+  double interval = 0.0;   // 95% half width of `corrected`
+  double reference_noise = 0.0;  // mean v_r / (r^2 + eps): the reference's own relMSE
+  bool reference_corrected = false;  // false: no reference variance, corrected == raw
+  // With the image's own variance: corrected minus the image's noise, an
+  // estimate of the squared bias alone (0 for an unbiased render), and its interval.
+  bool has_excess = false;
+  double image_noise = 0.0, excess = 0.0, excess_interval = 0.0;
+  // The part of the raw error that is the reference's own noise (0..1).
+  double reference_share() const { return raw > 0.0 ? reference_noise / raw : 0.0; }
+};
+// `reference_variance` and `image_variance` may be empty (unknown); otherwise
+// of the images' size.
+RelMseMeasure measure_relmse(const std::vector<float>& image, const std::vector<float>& reference,
+                             const std::vector<float>& reference_variance,
+                             const std::vector<float>& image_variance = {}, double epsilon = kRelMseEpsilon);
+
 // Efficiency = 1 / (relMSE * seconds): higher is better; independent of the
 // render time for an unbiased estimator whose error falls as 1/N.
 double efficiency(double relmse_value, double seconds);
+
+// The film's relMSE estimate over one render. For an unbiased strategy it
+// falls as 1/spp, so estimate * spp (the variance of one sample) stays about
+// flat; when that product grows by more than 2x over a doubling of the samples
+// (the estimate did not fall at all), rare bright paths are still being found
+// and the estimate says little: unreliable() stays true for the render.
+class EstimateHistory {
+ public:
+  static constexpr double kGrowthLimit = 2.0;
+  void clear() { *this = EstimateHistory(); }
+  void add(std::uint32_t spp, double estimated_relmse);
+  bool unreliable() const { return unreliable_; }
+  // estimate * spp now over the same at half the samples or fewer (0 before then).
+  double growth() const { return growth_; }
+
+ private:
+  std::vector<std::pair<std::uint32_t, double>> points_;  // spp, estimate * spp
+  bool unreliable_ = false;
+  double growth_ = 0.0;
+};
 
 // The film's own estimate of its noise, no reference needed: per pixel
 // sqrt(luminance of the per-channel variances of the mean) over (mean

@@ -93,6 +93,10 @@ struct QuadBatch {
 
 struct Scene {
   std::string name;
+  // Of the scene file's content without the image size, the depth and the
+  // description (scene_loader.cpp): what a reference image depends on besides
+  // those. Empty for a scene built in code.
+  std::string content_hash;
   Camera camera;
   int max_depth = 50;
   Vec3 background{0.0f};

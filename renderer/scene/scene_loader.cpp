@@ -2,6 +2,7 @@
 
 #include "renderer/error.h"
 #include "renderer/film/film.h"
+#include "renderer/hash.h"
 
 #include <nlohmann/json.hpp>
 
@@ -275,6 +276,17 @@ std::string line_and_column(const std::string& text, std::size_t byte) {
 
 namespace {
 
+// The parsed document without what a reference is keyed by separately (size,
+// depth) or what does not change the image (the description), dumped in one
+// canonical form (sorted keys, no spaces): reformatting a file keeps its hash.
+std::string content_hash(json doc) {
+  doc.erase("description");
+  if (doc.contains("camera") && doc["camera"].is_object())
+    for (const char* key : {"width", "height", "max_depth"}) doc["camera"].erase(key);
+  const std::string canonical = doc.dump();
+  return fnv1a_hex(canonical.data(), canonical.size());
+}
+
 Scene parse_scene(const std::string& text, const std::string& origin) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(origin + ": the scene is empty (expected a JSON object)");
@@ -326,6 +338,7 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
   for (std::size_t i = 0; i < objects.value().size(); ++i) parse_object(objects.element(i), by_name, scene);
 
   scene.prepare();
+  scene.content_hash = content_hash(doc);
   return scene;
 }
 

@@ -1,0 +1,291 @@
+#include "renderer/metrics/reference.h"
+
+#include "renderer/error.h"
+#include "renderer/film/film.h"
+#include "renderer/film/image_io.h"
+#include "renderer/hash.h"
+#include "renderer/metrics/metrics.h"
+#include "renderer/scene/scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace pdflab {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormat = "pdflab-reference";
+constexpr int kFormatVersion = 1;
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string file_checksum(const std::string& path) {
+  const std::string bytes = read_bytes(path);
+  return fnv1a_hex(bytes.data(), bytes.size());
+}
+
+// A reference with NaN or infinity would turn every error into NaN and rank
+// strategies at random; a negative variance is no variance. Say where the first bad value is.
+void check_values(const std::string& path, const std::vector<float>& values, int width, bool variance) {
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if ((!std::isfinite(values[i]) || (variance && values[i] < 0.0f)) && bad++ == 0) first = i;
+  if (bad == 0) return;
+  const std::size_t pixel = first / 3, w = static_cast<std::size_t>(width);
+  throw InputError((variance ? "variance file '" : "reference '") + path + "' has " + std::to_string(bad) +
+                   (variance ? " values that are negative or not finite" : " values that are not finite") +
+                   " (first at pixel " + std::to_string(pixel % w) + "," + std::to_string(pixel / w) + ")");
+}
+
+template <class T>
+T field(const json& j, const char* key, T fallback) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return fallback;
+  return it->get<T>();
+}
+
+json parse_json(const std::string& path) {
+  try {
+    json j = json::parse(read_bytes(path));
+    if (j.is_object()) return j;
+  } catch (const json::exception&) {
+    throw InputError("sidecar '" + path + "' is not valid JSON (truncated or damaged)");
+  }
+  throw InputError("sidecar '" + path + "' is not a JSON object");
+}
+
+ReferenceInfo parse_sidecar(const std::string& path, const json& j) {
+  ReferenceInfo info;
+  try {
+    info.has_sidecar = true;
+    info.is_reference = field<std::string>(j, "format", "") == kFormat;
+    info.scene_name = field<std::string>(j, "scene", "");
+    info.scene_file = field<std::string>(j, "scene_file", "");
+    info.scene_hash = field<std::string>(j, "scene_hash", "");
+    info.max_depth = field<int>(j, "max_depth", 0);
+    info.strategy = field<std::string>(j, "strategy", "");
+    if (j.contains("seed") && j["seed"].is_number_unsigned()) {
+      info.seed_known = true;
+      info.seed = j["seed"].get<std::uint64_t>();
+      if (is_reference_seed(info.seed)) info.seed_stream = static_cast<std::uint32_t>(info.seed - kReferenceSeedBase);
+    }
+    info.spp = field<std::uint32_t>(j, "spp", 0);
+    info.seconds = field<double>(j, "seconds", 0.0);
+    info.estimated_relmse = field<double>(j, "estimated_relmse", 0.0);
+    info.version = field<std::string>(j, "version", "");
+  } catch (const json::exception&) {
+    throw InputError("sidecar '" + path + "' has a field of the wrong type");
+  }
+  return info;
+}
+
+}  // namespace
+
+ReferencePaths reference_paths(const std::string& mean_path) {
+  fs::path p(mean_path);
+  ReferencePaths r;
+  r.mean = mean_path;
+  fs::path stem = p;
+  stem.replace_extension();
+  r.variance = stem.string() + ".var.pfm";
+  r.sidecar = stem.string() + ".json";
+  return r;
+}
+
+Reference reference_from_film(const Film& film, ReferenceInfo info) {
+  Reference r;
+  r.width = film.width();
+  r.height = film.height();
+  std::vector<float> map;
+  const NoiseSummary noise = noise_summary(film, map, kRelMseEpsilon, &r.rgb);
+  r.variance.resize(r.rgb.size());
+  for (std::size_t p = 0; p < film.pixel_count(); ++p) {
+    double v[3];
+    film.variance_of_mean(p, v);
+    for (int c = 0; c < 3; ++c) r.variance[3 * p + static_cast<std::size_t>(c)] = static_cast<float>(v[c]);
+  }
+  info.estimated_relmse = noise.estimated_relmse;
+  r.info = std::move(info);
+  return r;
+}
+
+void save_reference(const std::string& mean_path, const Reference& ref) {
+  const ReferencePaths paths = reference_paths(mean_path);
+  check_output_path(paths.mean);
+  if (!ref.has_variance()) throw InputError("a reference needs its variance to be saved");
+  const std::vector<std::uint8_t> mean = encode_pfm(ref.rgb, ref.width, ref.height);
+  const std::vector<std::uint8_t> variance = encode_pfm(ref.variance, ref.width, ref.height);
+  const ReferenceInfo& i = ref.info;
+  json j;
+  j["format"] = kFormat;
+  j["format_version"] = kFormatVersion;
+  j["scene"] = i.scene_name;
+  j["scene_file"] = i.scene_file;
+  j["scene_hash"] = i.scene_hash;
+  j["width"] = ref.width;
+  j["height"] = ref.height;
+  j["max_depth"] = i.max_depth;
+  j["strategy"] = i.strategy;
+  j["seed"] = i.seed;
+  j["seed_stream"] = i.seed_stream;
+  j["spp"] = i.spp;
+  j["seconds"] = i.seconds;
+  j["estimated_relmse"] = i.estimated_relmse;
+  j["version"] = i.version;
+  j["mean_file"] = fs::path(paths.mean).filename().string();
+  j["variance_file"] = fs::path(paths.variance).filename().string();
+  j["mean_checksum"] = fnv1a_hex(mean.data(), mean.size());
+  j["variance_checksum"] = fnv1a_hex(variance.data(), variance.size());
+  const std::string text = j.dump(2) + "\n";
+  write_file_atomic(paths.variance, variance);
+  write_file_atomic(paths.mean, mean);
+  write_file_atomic(paths.sidecar, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+Reference load_reference(const std::string& path) {
+  const ReferencePaths paths = reference_paths(path);
+  Reference r;
+  r.path = path;
+  r.rgb = read_pfm(path, r.width, r.height);  // InputError naming the file
+  check_values(path, r.rgb, r.width, false);
+  std::error_code ec;
+  if (fs::is_regular_file(paths.sidecar, ec)) try {
+    const json j = parse_json(paths.sidecar);
+    r.info = parse_sidecar(paths.sidecar, j);
+    if (r.info.is_reference) {
+      const int w = field<int>(j, "width", 0), h = field<int>(j, "height", 0);
+      if (w != r.width || h != r.height)
+        throw InputError("reference '" + path + "' is " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                         " but its sidecar says " + std::to_string(w) + "x" + std::to_string(h));
+      if (field<std::string>(j, "mean_checksum", "") != file_checksum(path))
+        throw InputError("reference '" + path + "' does not match the checksum in its sidecar (changed or damaged)");
+      if (!fs::is_regular_file(paths.variance, ec))
+        throw InputError("reference '" + path + "': its variance file '" + paths.variance + "' is missing");
+      if (field<std::string>(j, "variance_checksum", "") != file_checksum(paths.variance))
+        throw InputError("variance file '" + paths.variance +
+                         "' does not match the checksum in its sidecar (changed or damaged)");
+      int vw = 0, vh = 0;
+      r.variance = read_pfm(paths.variance, vw, vh);
+      if (vw != r.width || vh != r.height)
+        throw InputError("variance file '" + paths.variance + "' is not the size of its reference");
+      check_values(paths.variance, r.variance, r.width, true);
+    }
+  } catch (const json::exception&) {
+    throw InputError("sidecar '" + paths.sidecar + "' has a field of the wrong type");
+  }
+  return r;
+}
+
+std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t seed, const Strategy& strategy) {
+  if (!reference.seed_known || reference.seed != seed) return {};
+  const bool same_strategy = reference.strategy == strategy.to_string();
+  return "the reference was rendered with seed " + std::to_string(seed) + (same_strategy ? " and strategy " : "") +
+         (same_strategy ? reference.strategy : std::string()) +
+         ", the same as this render: the two would share random numbers and the error would look too small";
+}
+
+Strategy default_reference_strategy(const Scene& scene) {
+  const Strategy book = Strategy::parse("mix:cosine=0.5,light=0.5");
+  try {
+    (void)SamplingPlan::make(book, scene);
+    return book;
+  } catch (const InputError&) {
+    return Strategy::single(Technique::Cosine);
+  }
+}
+
+std::string reference_cache_dir(const std::string& option) {
+  if (!option.empty()) return option;
+  if (const char* env = std::getenv("PDFLAB_REFERENCE_CACHE"); env && *env) return env;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return (fs::path(xdg) / "pdflab" / "references").string();
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return (fs::path(home) / ".cache" / "pdflab" / "references").string();
+  return (fs::path(".cache") / "pdflab" / "references").string();
+}
+
+std::string ReferenceKey::stem() const {
+  return scene_hash + "-" + std::to_string(width) + "x" + std::to_string(height) + "-d" + std::to_string(max_depth);
+}
+
+ReferenceKey reference_key(const Scene& scene) {
+  ReferenceKey k;
+  k.scene_hash = scene.content_hash.empty() ? std::string("unhashed") : scene.content_hash;
+  k.width = scene.camera.width;
+  k.height = scene.camera.height;
+  k.max_depth = scene.max_depth;
+  return k;
+}
+
+std::string cached_reference_path(const std::string& cache_dir, const ReferenceKey& key) {
+  return (fs::path(cache_dir) / (key.stem() + ".pfm")).string();
+}
+
+CacheLookup find_cached_reference(const std::string& cache_dir, const ReferenceKey& key) {
+  CacheLookup out;
+  out.path = cached_reference_path(cache_dir, key);
+  std::error_code ec;
+  const ReferencePaths paths = reference_paths(out.path);
+  if (!fs::exists(paths.mean, ec) && !fs::exists(paths.sidecar, ec)) return out;
+  try {
+    Reference r = load_reference(out.path);
+    if (!r.info.is_reference) throw InputError("its sidecar is missing or not a reference's");
+    if (r.info.scene_hash != key.scene_hash || r.width != key.width || r.height != key.height ||
+        r.info.max_depth != key.max_depth)
+      throw InputError("its sidecar names another scene, size or depth");
+    out.status = CacheLookup::Found;
+    out.reference = std::move(r);
+  } catch (const std::exception& e) {
+    out.status = CacheLookup::Damaged;
+    out.message = "cached reference '" + out.path + "' is damaged and was ignored: " + e.what();
+  }
+  return out;
+}
+
+std::string store_cached_reference(const std::string& cache_dir, const ReferenceKey& key, const Reference& reference) {
+  std::error_code ec;
+  fs::create_directories(cache_dir, ec);
+  if (ec) throw InputError("cannot create the reference cache folder '" + cache_dir + "': " + ec.message());
+  const std::string path = cached_reference_path(cache_dir, key);
+  save_reference(path, reference);
+  return path;
+}
+
+ReferenceProgress reference_progress(const ReferenceGoal& goal, std::uint32_t spp, double seconds,
+                                     double estimated_relmse) {
+  ReferenceProgress p;
+  if (goal.spp > 0) {
+    p.fraction = static_cast<double>(spp) / goal.spp;
+    p.reached = spp >= goal.spp;
+  } else if (goal.seconds > 0.0) {
+    p.fraction = seconds / goal.seconds;
+    p.reached = seconds >= goal.seconds;
+  } else if (goal.relmse > 0.0) {
+    // relMSE * time stays about constant: the time needed is seconds * est / target.
+    if (spp >= 2 && estimated_relmse > 0.0) {
+      p.reached = estimated_relmse <= goal.relmse;
+      p.fraction = std::min(1.0, goal.relmse / estimated_relmse);
+    } else {
+      p.reached = spp >= 2 && estimated_relmse <= 0.0;  // a black image is converged
+    }
+  }
+  p.fraction = std::clamp(p.fraction, 0.0, 1.0);
+  if (p.reached) p.fraction = 1.0;
+  if (!p.reached && p.fraction > 0.0 && seconds > 0.0) p.seconds_left = seconds * (1.0 - p.fraction) / p.fraction;
+  return p;
+}
+
+}  // namespace pdflab
