@@ -74,6 +74,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 30));
   app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
   std::string view_reference;
+  float view_ui_scale = 1.0f;
+  bool view_presentation = false;
+  app.add_option("--ui-scale", view_ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
+      ->check(CLI::Range(0.5f, 4.0f));
+  app.add_flag("--presentation", view_presentation, "Start in presentation mode: full screen, no panel (F11 leaves)");
   app.add_option("--reference", view_reference, "Reference image (PFM) for live error figures in the viewer");
 
   pdflab::RenderOptions ro;
@@ -170,6 +175,8 @@ int main(int argc, char** argv) {
     vo.spp = view_spp;
     vo.screenshot = screenshot;
     vo.reference = view_reference;
+    vo.ui_scale = view_ui_scale;
+    vo.presentation = view_presentation;
     return pdflab::run_viewer(vo);
 #else
     // Built without the viewer: render the default scene headlessly instead.

@@ -138,6 +138,12 @@ struct Viewer::Impl {
 
   bool fonts_dirty = true;
   float content_scale = 1.0f;
+  float ui_scale = 1.0f;  // the fonts' (settings.ui_scale is the wish)
+  float scale() const { return content_scale * ui_scale; }
+  // Presentation mode's full screen; the window's place to go back to.
+  bool fullscreen = false;
+  int windowed_x = 0, windowed_y = 0, windowed_w = 0, windowed_h = 0;
+  double presentation_since = -1.0;
   float framebuffer_scale = 1.0f;
 
   FrameReport report;
@@ -154,6 +160,7 @@ struct Viewer::Impl {
   void rebuild_fonts();
   void on_key(int key, int mods);
   void on_escape();
+  void set_presentation(bool on);
   void navigate(const ui::Viewport& area, int framebuffer_height);
   void inspect(const ui::ImageRect& image_rect, const ui::ImageRect& area_rect);
   void request_quit();
@@ -190,6 +197,9 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   settings.max_depth = scene.max_depth;
   settings.stop_spp = cli_mode() ? options.spp : o.spp;
   settings.screenshot_dir = default_screenshot_dir();
+  if (!(o.ui_scale >= ui::kMinUiScale && o.ui_scale <= ui::kMaxUiScale))
+    throw InputError("--ui-scale " + std::to_string(o.ui_scale) + " is outside 0.5..4");
+  settings.ui_scale = o.ui_scale;
   if (!o.reference.empty()) {
     measure.set_reference(ui::load_reference(o.reference));  // a bad file is bad input, before any window
     settings.measure.reference_field = o.reference;
@@ -208,6 +218,7 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   session = std::make_unique<RenderSession>(so);
   teaching = std::make_unique<TeachingViews>(so.on_image);
   if (!apply_render_settings()) throw InputError(status.settings_error);
+  if (o.presentation && !cli_mode()) set_presentation(true);
 }
 
 void Viewer::Impl::open_window(int image_width, int image_height) {
@@ -233,7 +244,7 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
     // screens, like everything else), within reason, plus the panel.
     const int image_w = static_cast<int>(static_cast<float>(std::clamp(image_width, 320, 1000)) * scale);
     const int image_h = static_cast<int>(static_cast<float>(std::clamp(image_height, 320, 1000)) * scale);
-    width = image_w + static_cast<int>(kPanelWidth * scale);
+    width = image_w + static_cast<int>(kPanelWidth * scale * options.ui_scale);
     height = std::max(image_h, static_cast<int>(800.0f * scale));
     if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
       width = std::min(width, mode->width * 19 / 20);
@@ -299,18 +310,21 @@ void Viewer::Impl::rebuild_fonts() {
   // larger than the window; ImGui works in window coordinates.
   const float new_fb = ww > 0 && fw > 0 ? static_cast<float>(fw) / static_cast<float>(ww) : framebuffer_scale;
   ImGuiIO& io = ImGui::GetIO();
-  if (new_content == content_scale && new_fb == framebuffer_scale && io.Fonts->Fonts.Size > 0) return;
+  if (new_content == content_scale && new_fb == framebuffer_scale && settings.ui_scale == ui_scale &&
+      io.Fonts->Fonts.Size > 0)
+    return;
   content_scale = new_content;
   framebuffer_scale = new_fb;
+  ui_scale = settings.ui_scale;
 
   io.Fonts->Clear();
-  const float pixels = 15.0f * content_scale;  // rasterised at the real pixel size, so text stays sharp
+  const float pixels = 15.0f * scale();  // rasterised at the real pixel size, so text stays sharp
   std::error_code ec;
   if (fs::exists(kUiFont, ec)) {
     io.Fonts->AddFontFromFileTTF(kUiFont, pixels);
   } else {
     ImFontConfig cfg;
-    cfg.SizePixels = 13.0f * content_scale;
+    cfg.SizePixels = 13.0f * scale();
     io.Fonts->AddFontDefault(&cfg);
   }
   io.FontGlobalScale = 1.0f / framebuffer_scale;
@@ -324,7 +338,7 @@ void Viewer::Impl::rebuild_fonts() {
   style.FrameRounding = 3.0f;
   style.GrabRounding = 3.0f;
   style.WindowBorderSize = 0.0f;
-  style.ScaleAllSizes(content_scale / framebuffer_scale);
+  style.ScaleAllSizes(scale() / framebuffer_scale);
 }
 
 void Viewer::Impl::close() {
@@ -449,6 +463,10 @@ void Viewer::Impl::on_escape() {
     close_popups = true;  // in the next frame (ImGui closes popups on Esc only with keyboard navigation on)
     return;
   }
+  if (settings.presentation) {
+    set_presentation(false);
+    return;
+  }
   if (teaching->on_escape()) return;
   if (panel.show_help) panel.show_help = false;
 }
@@ -474,6 +492,7 @@ void Viewer::Impl::on_key(int key, int mods) {
   const int w = image_info.width, h = image_info.height;
   const double cx = last_area.x + last_area.width * 0.5, cy = last_area.y + last_area.height * 0.5;
   switch (key) {
+    case GLFW_KEY_F11: set_presentation(!settings.presentation); return;
     case GLFW_KEY_F: view.fit = true; return;
     case GLFW_KEY_Z: view.actual_size(last_area, w, h); return;
     case GLFW_KEY_EQUAL:
@@ -507,6 +526,24 @@ void Viewer::Impl::on_key(int key, int mods) {
     case GLFW_KEY_F1: panel.show_help = !panel.show_help; break;
     default: break;
   }
+}
+
+void Viewer::Impl::set_presentation(bool on) {
+  settings.presentation = on;
+  presentation_since = on ? now() : -1.0;
+  settle_frames = 3;
+  GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+  const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr;
+  if (on && !fullscreen && mode) {
+    glfwGetWindowPos(window, &windowed_x, &windowed_y);
+    glfwGetWindowSize(window, &windowed_w, &windowed_h);
+    glfwSetWindowMonitor(window, monitor, 0, 0, mode->width, mode->height, mode->refreshRate);
+    fullscreen = true;
+  } else if (!on && fullscreen) {
+    glfwSetWindowMonitor(window, nullptr, windowed_x, windowed_y, windowed_w, windowed_h, 0);
+    fullscreen = false;
+  }
+  view.fit = true;  // the new area, the whole picture
 }
 
 void Viewer::Impl::navigate(const ui::Viewport& area, int framebuffer_height) {
@@ -730,6 +767,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   if (v.settle_frames > 0) --v.settle_frames;
   v.last_draw = t0;
 
+  if (v.settings.ui_scale != v.ui_scale) v.fonts_dirty = true;
   if (v.fonts_dirty) v.rebuild_fonts();
   if (v.texture_stale) {
     v.display->upload(v.image.data(), v.image_info.data_width, v.image_info.data_height);
@@ -745,7 +783,9 @@ bool Viewer::frame(bool paced, bool force_draw) {
   v.close_popups = false;
   v.fill_status();
   const ImGuiIO& io = ImGui::GetIO();
-  const float panel_width = std::min(kPanelWidth * v.content_scale / v.framebuffer_scale, io.DisplaySize.x);
+  const bool presenting = v.settings.presentation;
+  const float panel_width =
+      presenting ? 0.0f : std::min(kPanelWidth * v.scale() / v.framebuffer_scale, io.DisplaySize.x);
   const float fbs = v.framebuffer_scale;
   const int panel_px = static_cast<int>(panel_width * fbs);
   const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
@@ -760,12 +800,19 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(area_rect.x, area_rect.y),
                                                ImVec2(area_rect.x + area_rect.width, area_rect.y + area_rect.height));
   ui::UiRequests requests;
-  ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
+  if (!presenting) {
+    ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
+    ui::draw_image_badges(v.settings, v.status);
+  } else if (v.now() - v.presentation_since < 3.0) {
+    ui::draw_hint("Presentation mode: F11 or Esc leaves");
+  }
   ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
-  ui::draw_image_badges(v.settings, v.status);
+  if (!v.status.notice.text.empty() && v.now() - v.status.notice.shown_at < 6.0)
+    ui::draw_notice_toast(v.status.notice, area_rect.width, area_rect.height);
   ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
   v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, area_rect.width, area_rect.height);
-  v.inspect(image_rect, area_rect);
+  if (!presenting) v.inspect(image_rect, area_rect);
+  else v.inspected.reset();
   ImGui::GetBackgroundDrawList()->PopClipRect();
   if (v.quit_asking) {
     switch (ui::draw_quit_dialog(v.unsaved_seconds(), v.quit_after_save || v.save_job.valid(), v.status.notice)) {
@@ -788,6 +835,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
     v.applied.stop_spp = v.settings.stop_spp;
   }
   if (requests.screenshot) v.screenshot_wanted = true;
+  if (requests.toggle_presentation) v.set_presentation(!v.settings.presentation);
   v.handle_measure_requests(requests.measure);
   if (requests.retry_screenshot && v.failed_save) {
     ui::ScreenshotData data = std::move(*v.failed_save);

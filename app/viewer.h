@@ -17,6 +17,8 @@ struct ViewerOptions {
   // Window size in screen coordinates (0: fit the image and the panel).
   int window_width = 0, window_height = 0;
   std::string reference;  // PFM to measure the error against (empty: none)
+  float ui_scale = 1.0f;  // panels and text, times the screen's own scale (0.5..4)
+  bool presentation = false;  // start full screen without the panel
 };
 
 // Runs the viewer until the window closes. Returns the process exit status;

@@ -324,7 +324,8 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
 }
 
 void draw_nee_explanation() {
-  if (!ImGui::TreeNodeEx("How is this different from a mixture?", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  // Closed at first: the note is long, the panel is for controls.
+  if (!ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None)) return;
   ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.85f, 0.85f, 0.88f, 1.0f));
   ImGui::TextWrapped(
       "A mixture (mix:...) draws ONE direction per bounce: it picks a technique by its weight, samples it, and "

@@ -34,7 +34,7 @@ void stat_cell(const char* label, const char* fmt, auto... args) {
   ImGui::Text(fmt, args...);
 }
 
-void sampling_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
+void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
   SamplingSettings& s = settings.sampling;
   const SamplingSettings before = s;
 
@@ -74,15 +74,32 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
 
   if (s.nee_mis) draw_nee_explanation();
   if (s.mixture && !s.nee_mis) {
+    // The book's two-technique mixture as one number: w * A + (1 - w) * B.
+    state.w_pair = two_technique_pair(s, state.w_pair);
+    if (state.w_pair[0] >= 0) {
+      const int a = state.w_pair[0], b = state.w_pair[1];
+      const float sum = s.weights[a] + s.weights[b];
+      float w = sum > 0.0f ? s.weights[a] / sum : 0.5f;
+      ImGui::TextColored(kDim, "w\xc2\xb7%s + (1-w)\xc2\xb7%s", std::string(technique_name(static_cast<Technique>(a))).c_str(),
+                         std::string(technique_name(static_cast<Technique>(b))).c_str());
+      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+      if (ImGui::SliderFloat("w##pair", &w, 0.0f, 1.0f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
+        s.weights[a] = w;
+        s.weights[b] = 1.0f - w;
+      }
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
+    }
     const auto norm = s.normalised();
-    ImGui::TextColored(kDim, "weight per technique        normalised");
+    ImGui::TextColored(kDim, "weight per technique         fraction");
     for (int i = 0; i < kTechniqueCount; ++i) {
       ImGui::PushID(i);
       ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
       const std::string name(technique_name(static_cast<Technique>(i)));
-      ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.2f").c_str(), ImGuiSliderFlags_AlwaysClamp);
+      ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.3g").c_str(), ImGuiSliderFlags_AlwaysClamp);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Raw weight; the renderer normalises. Ctrl+click to type one.");
       ImGui::SameLine();
-      ImGui::Text("%.3f", norm[i]);
+      if (norm[i] > 0.0f) ImGui::Text("%.1f%%", norm[i] * 100.0f);
+      else ImGui::TextColored(kDim, "0%%");
       ImGui::PopID();
     }
     bool any = false;
@@ -90,12 +107,20 @@ void sampling_section(ViewerSettings& settings, const UiStatus& status, UiReques
     if (!any) ImGui::TextColored(kRed, "All weights are 0: the image keeps the last valid mixture.");
   }
 
+  // The presets' buttons in a row that wraps where the panel ends.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+  const auto flow_button = [&](const char* label, bool first) {
+    const float w = ImGui::CalcTextSize(label).x + style.FramePadding.x * 2.0f;
+    if (!first && ImGui::GetItemRectMax().x + style.ItemSpacing.x + w <= right) ImGui::SameLine();
+    return ImGui::Button(label);
+  };
   for (int p = 1; p <= kPresetCount; ++p) {
     char label[48];
     std::snprintf(label, sizeof label, "%d: %s", p, preset_label(static_cast<Preset>(p)));
-    if (p > 1) ImGui::SameLine();
-    if (ImGui::Button(label)) s = preset_sampling(static_cast<Preset>(p));
+    if (flow_button(label, p == 1)) s = preset_sampling(static_cast<Preset>(p));
   }
+  if (flow_button("4: nee-mis", false)) s = SamplingSettings::from(Strategy::nee());
 
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;
@@ -185,7 +210,7 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
   if (ImGui::Button("Restart (R)")) requests.restart_render = true;
 }
 
-void display_section(ViewerSettings& settings) {
+void display_section(ViewerSettings& settings, UiRequests& requests) {
   ImGui::SliderFloat("Exposure", &settings.exposure_ev, -6.0f, 6.0f, "%+.1f EV");
   if (ImGui::IsItemClicked(ImGuiMouseButton_Right)) settings.exposure_ev = 0.0f;
   int transfer = settings.srgb ? 1 : 0;
@@ -194,6 +219,19 @@ void display_section(ViewerSettings& settings) {
   ImGui::RadioButton("sRGB", &transfer, 1);
   settings.srgb = transfer == 1;
   draw_view_mode_selector(settings);
+  char scale[16];
+  std::snprintf(scale, sizeof scale, "%.0f%%", settings.ui_scale * 100.0f);
+  if (ImGui::BeginCombo("UI scale", scale)) {
+    for (float s : kUiScales) {
+      std::snprintf(scale, sizeof scale, "%.0f%%", s * 100.0f);
+      if (ImGui::Selectable(scale, s == settings.ui_scale)) settings.ui_scale = s;
+    }
+    ImGui::EndCombo();
+  }
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Larger text for a projector (also: pdflab --ui-scale 1.5)");
+  if (ImGui::Button("Presentation mode (F11)")) requests.toggle_presentation = true;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Full screen, the image alone: no panel, badges or inspector. F11 or Esc leaves.");
 }
 
 // In the split the main render rests: the two sides are what runs.
@@ -299,8 +337,10 @@ void draw_side_panel(float width, float display_height, ViewerSettings& settings
   const ImGuiViewport* vp = ImGui::GetMainViewport();
   ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x - width, vp->Pos.y));
   ImGui::SetNextWindowSize(ImVec2(width, display_height));
+  // Behind every other window, always: it is the background the views open over.
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoTitleBar;
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoTitleBar |
+                                 ImGuiWindowFlags_NoBringToFrontOnFocus;
   // The viewer clears the panel's rectangle itself (kPanelBackground): a
   // full-height filled quad is the costliest thing ImGui draws on a software
   // rasteriser, a clear costs next to nothing.
@@ -308,12 +348,12 @@ void draw_side_panel(float width, float display_height, ViewerSettings& settings
   ImGui::Begin("pdflab", nullptr, flags);
   ImGui::PopStyleColor();
   ImGui::PushItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-  if (ImGui::CollapsingHeader("Sampling", ImGuiTreeNodeFlags_DefaultOpen)) sampling_section(settings, status, requests);
+  if (ImGui::CollapsingHeader("Sampling", ImGuiTreeNodeFlags_DefaultOpen)) sampling_section(settings, state, status, requests);
   if (ImGui::CollapsingHeader("Scene and render", ImGuiTreeNodeFlags_DefaultOpen))
     scene_section(settings, state, status, requests);
   if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics_section(settings, status);
   if (ImGui::CollapsingHeader("Measure", ImGuiTreeNodeFlags_DefaultOpen)) draw_measure_section(settings, status, requests);
-  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings);
+  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings, requests);
   if (ImGui::CollapsingHeader("Screenshot", ImGuiTreeNodeFlags_DefaultOpen))
     screenshot_section(settings, status, requests);
   ImGui::PopItemWidth();
@@ -347,6 +387,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"drag", "pan (right or middle button; left outside probe mode)"},
         {"Z, F", "one image pixel per screen pixel; fit the window"},
         {"Ctrl+C", "copy the pixel inspector's values"},
+        {"F11", "presentation mode: full screen, the image alone"},
         {"H, F1", "this help"},
         {"Esc", "close a drop-down, cancel an edit, leave probe mode"},
         {"Ctrl+Q", "quit (asks first when a render is unsaved)"},
@@ -375,6 +416,31 @@ void draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
   if (ImGui::Begin("##badges", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text.c_str());
+  ImGui::End();
+}
+
+void draw_hint(const char* text) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x * 0.5f, vp->Pos.y + 12.0f), ImGuiCond_Always, ImVec2(0.5f, 0.0f));
+  ImGui::SetNextWindowBgAlpha(0.7f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+  if (ImGui::Begin("##hint", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text);
+  ImGui::End();
+}
+
+void draw_notice_toast(const Notice& notice, float area_width, float area_height) {
+  ImGui::SetNextWindowPos(ImVec2(area_width * 0.5f, area_height - 12.0f), ImGuiCond_Always, ImVec2(0.5f, 1.0f));
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+  if (ImGui::Begin("##notice", nullptr, flags)) {
+    ImGui::PushTextWrapPos(std::max(ImGui::GetFontSize() * 10.0f, area_width - 40.0f));
+    ImGui::TextColored(notice.error ? kRed : kGreen, "%s", notice.text.c_str());
+    ImGui::PopTextWrapPos();
+  }
   ImGui::End();
 }
 

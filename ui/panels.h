@@ -20,6 +20,12 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height);
 // A short line over the image (preview, paused, biased), top-left of the image area.
 void draw_image_badges(const ViewerSettings& settings, const UiStatus& status);
 
+// A short line at the top centre of the display (a mode just entered).
+void draw_hint(const char* text);
+// The last screenshot notice over the image area's bottom, where it is seen
+// (the Screenshot section may be below the fold).
+void draw_notice_toast(const Notice& notice, float area_width, float area_height);
+
 // The question before quitting with an unsaved render, over everything (the
 // rest of the window takes no input meanwhile).
 enum class QuitChoice { None, SaveAndQuit, Quit, Cancel };

@@ -44,6 +44,19 @@ std::array<float, kTechniqueCount> SamplingSettings::normalised() const {
   return out;
 }
 
+std::array<int, 2> two_technique_pair(const SamplingSettings& s, std::array<int, 2> remembered) {
+  if (s.nee_mis || !s.mixture) return {-1, -1};
+  std::array<int, 2> positive{-1, -1};
+  int count = 0;
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (s.weights[i] > 0.0f && count++ < 2) positive[static_cast<std::size_t>(count - 1)] = i;
+  if (count == 2) return positive;
+  if (remembered[0] < 0 || remembered[1] < 0 || remembered[0] == remembered[1]) return {-1, -1};
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (i != remembered[0] && i != remembered[1] && s.weights[i] > 0.0f) return {-1, -1};
+  return remembered;
+}
+
 double unsaved_seconds(const SaveMark& saved, std::uint64_t generation, double seconds) {
   if (saved.generation != generation) return seconds;
   return std::max(0.0, seconds - saved.seconds);

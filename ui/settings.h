@@ -37,6 +37,11 @@ inline constexpr int kPresetCount = 3;
 const char* preset_label(Preset p);
 SamplingSettings preset_sampling(Preset p);
 
+// The two techniques of a two-technique mixture (w * A + (1 - w) * B, the
+// book's form): `remembered` when the others are all 0 (w may be 0 or 1 then),
+// else the two with positive weights when exactly two have; {-1, -1} otherwise.
+std::array<int, 2> two_technique_pair(const SamplingSettings& s, std::array<int, 2> remembered);
+
 // Quitting asks first when a render has run longer than this since it was last saved.
 inline constexpr double kUnsavedAskSeconds = 5.0;
 struct SaveMark {
@@ -58,12 +63,17 @@ struct ViewerSettings {
   bool srgb = false;  // false: the book's gamma 2
   std::string screenshot_dir = "screenshots";
   MeasureSettings measure;
+  // Presentation: full screen, no side panel, no badges or inspector over the image.
+  bool presentation = false;
+  float ui_scale = 1.0f;  // panels and text, times the screen's content scale
   // Non-zero: render at exactly this size instead of the scene's times
   // resolution_scale (set to match a reference image).
   int width_override = 0, height_override = 0;
 };
 
 inline constexpr std::array<float, 5> kResolutionScales = {0.25f, 0.5f, 1.0f, 1.5f, 2.0f};
+inline constexpr std::array<float, 6> kUiScales = {0.75f, 1.0f, 1.25f, 1.5f, 2.0f, 2.5f};
+inline constexpr float kMinUiScale = 0.5f, kMaxUiScale = 4.0f;
 
 // What the panels ask for this frame, beyond edits to ViewerSettings.
 struct UiRequests {
@@ -72,6 +82,7 @@ struct UiRequests {
   bool pause_changed = false;
   bool screenshot = false;
   bool retry_screenshot = false;
+  bool toggle_presentation = false;
   std::string load_scene;  // non-empty: try this file
   MeasureRequests measure;
 };
@@ -109,6 +120,8 @@ struct PanelState {
   std::string scene_path_field;
   bool show_help = false;
   bool scene_field_initialised = false;
+  // The two techniques of the "w" slider, kept while it is dragged to 0 or 1.
+  std::array<int, 2> w_pair{-1, -1};
 };
 
 }  // namespace pdflab::ui

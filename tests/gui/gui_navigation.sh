@@ -103,6 +103,24 @@ shot fit_again "60x60+$((mx - 30))+$((my - 30))"
 d=$(rmse "$art/fitted.png" "$art/fit_again.png")
 echo "fitted vs fitted again: RMSE $d"
 awk -v d="$d" 'BEGIN { exit !(d < 0.01) }' || fail "F did not restore the fitted view"
+echo "== F11: presentation mode, the whole screen and no panel; Esc leaves it"
+shot windowed
+xdotool key --window "$wid" F11
+sleep 1.5
+eval "$(xdotool getwindowgeometry --shell "$wid")"
+echo "presentation: ${WIDTH}x${HEIGHT}"
+[ "$WIDTH" = 1280 ] && [ "$HEIGHT" = 800 ] || fail "F11 did not fill the screen (${WIDTH}x${HEIGHT})"
+shot presentation
+# No panel: the right edge shows the image area's dark background, not the panel's controls.
+convert "$art/presentation.png" -crop 220x500+1055+150 +repage "$art/presentation_right.png"
+sd=$(identify -format "%[fx:standard_deviation]" "$art/presentation_right.png")
+echo "right edge in presentation: stddev $sd"
+awk -v s="$sd" 'BEGIN { exit !(s < 0.02) }' || fail "the side panel still shows in presentation mode"
+xdotool key --window "$wid" Escape
+sleep 1.5
+alive "$viewer" "Esc in presentation mode"
+eval "$(xdotool getwindowgeometry --shell "$wid")"
+[ "$WIDTH" = 720 ] || fail "Esc did not leave presentation mode (${WIDTH}x${HEIGHT})"
 quit_viewer "$wid" "$viewer"
 trap - EXIT
 echo "PASS"

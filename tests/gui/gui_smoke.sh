@@ -26,6 +26,8 @@ set +e
 [ $? -eq 2 ] || fail "missing scene: expected status 2"
 "$pdflab" --scene "$scene" --spp 2 --screenshot "$art/no/such/folder/x.png" 2>"$art/bad_out.txt"
 [ $? -eq 2 ] || fail "unwritable screenshot path: expected status 2"
+"$pdflab" --scene "$scene" --ui-scale 9 2>"$art/bad_ui_scale.txt"
+[ $? -eq 2 ] || fail "--ui-scale 9: expected status 2"
 set -e
 [ ! -e "$art/never.png" ] || fail "bad input left an output file"
 cat "$art"/bad_*.txt

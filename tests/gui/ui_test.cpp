@@ -136,6 +136,22 @@ TEST(PixelInspector, ReadsThePublishedPixelItsNoiseAndTheReference) {
   EXPECT_LT(p->relative_standard_error, 0.0);
 }
 
+TEST(SamplingSettings, TheWSliderPairIsTheTwoTechniquesInUseAndSurvivesZero) {
+  const int cos = static_cast<int>(Technique::Cosine), light = static_cast<int>(Technique::Light);
+  auto s = ui::SamplingSettings::from(Strategy::parse("mix:cosine=0.5,light=0.93"));
+  EXPECT_EQ(ui::two_technique_pair(s, {-1, -1}), (std::array<int, 2>{cos, light}));
+  // Dragged to w = 1: light's weight is 0, the pair stays while no other technique is used.
+  s.weights[light] = 0.0f;
+  EXPECT_EQ(ui::two_technique_pair(s, {cos, light}), (std::array<int, 2>{cos, light}));
+  EXPECT_EQ(ui::two_technique_pair(s, {-1, -1}), (std::array<int, 2>{-1, -1}));
+  // A third technique in use: no single w.
+  s.weights[light] = 0.5f;
+  s.weights[static_cast<int>(Technique::UniformSphere)] = 0.1f;
+  EXPECT_EQ(ui::two_technique_pair(s, {cos, light}), (std::array<int, 2>{-1, -1}));
+  EXPECT_EQ(ui::two_technique_pair(ui::SamplingSettings::from(Strategy::nee()), {cos, light}),
+            (std::array<int, 2>{-1, -1}));
+}
+
 TEST(QuitGuard, UnsavedSecondsCountFromTheLastSaveOfTheSameRender) {
   const ui::SaveMark none;
   EXPECT_DOUBLE_EQ(ui::unsaved_seconds(none, 3, 12.0), 12.0);
