@@ -105,6 +105,36 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
 
 }  // namespace
 
+Reference comparison_reference(Scene& scene, const ReferenceChoice& choice, const std::vector<Strategy>& strategies,
+                               const std::vector<std::uint64_t>& seeds, bool quiet) {
+  Reference reference;
+  if (choice.option == "auto") {
+    if (choice.width) scene.camera.width = choice.width;
+    if (choice.height) scene.camera.height = choice.height;
+    check_image_size(scene.camera.width, scene.camera.height, "--width/--height");
+    scene.prepare();
+    reference = resolve_reference(choice.option, scene, choice.scene_file, choice.cache_dir, true, quiet);
+  } else {
+    if (choice.width || choice.height)
+      throw InputError("--width/--height go with --reference auto; a file's size is its own");
+    reference = load_reference(choice.option);  // InputError: unreadable, truncated, not finite
+    scene.camera.width = reference.width;
+    scene.camera.height = reference.height;
+    scene.prepare();
+  }
+  // Decorrelation: no run may repeat the reference's random numbers.
+  for (const Strategy& s : strategies)
+    for (std::uint64_t seed : seeds)
+      if (const std::string shared = shared_random_numbers(reference.info, seed, s); !shared.empty())
+        throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  if (!quiet && !reference.has_variance())
+    std::fprintf(stderr,
+                 "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "
+                 "(make one with pdflab reference)\n",
+                 reference.path.c_str());
+  return reference;
+}
+
 int run_bench(const BenchOptions& o) {
   if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
     throw InputError("--seconds must be a positive number of seconds");
@@ -117,29 +147,8 @@ int run_bench(const BenchOptions& o) {
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
-  Reference reference;
-  if (o.reference == "auto") {
-    if (o.width) scene->camera.width = o.width;
-    if (o.height) scene->camera.height = o.height;
-    check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
-    scene->prepare();
-    reference = resolve_reference(o.reference, *scene, o.scene, o.cache_dir, true, o.quiet);
-  } else {
-    if (o.width || o.height) throw InputError("--width/--height go with --reference auto; a file's size is its own");
-    reference = load_reference(o.reference);  // InputError: unreadable, truncated, not finite
-    scene->camera.width = reference.width;
-    scene->camera.height = reference.height;
-    scene->prepare();
-  }
-  // Decorrelation: no run may repeat the reference's random numbers.
-  for (const Strategy& s : strategies)
-    if (const std::string shared = shared_random_numbers(reference.info, o.seed, s); !shared.empty())
-      throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
-  if (!o.quiet && !reference.has_variance())
-    std::fprintf(stderr,
-                 "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "
-                 "(make one with pdflab reference)\n",
-                 reference.path.c_str());
+  const Reference reference = comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height},
+                                                   strategies, {o.seed}, o.quiet);
 
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
   if (!o.quiet)

@@ -1,6 +1,11 @@
 #pragma once
+#include "renderer/metrics/reference.h"
+#include "renderer/sampling/strategy.h"
+#include "renderer/scene/scene.h"
+
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace pdflab {
 
@@ -21,6 +26,18 @@ struct BenchOptions {
   int threads = 0;
   bool quiet = false;
 };
+
+// `--reference FILE|auto` of a headless comparison (bench, sweep): sizes and
+// prepares `scene` (to the file's size, or to width/height with auto), loads
+// the reference, and refuses any of `seeds` x `strategies` that would repeat
+// the reference's random numbers. InputError for all of these.
+struct ReferenceChoice {
+  std::string option;  // a .pfm or "auto"
+  std::string scene_file, cache_dir;
+  int width = 0, height = 0;  // with auto; 0: the scene's
+};
+Reference comparison_reference(Scene& scene, const ReferenceChoice& choice, const std::vector<Strategy>& strategies,
+                               const std::vector<std::uint64_t>& seeds, bool quiet);
 
 // Runs `pdflab bench`. Returns the exit status; throws InputError for bad input.
 int run_bench(const BenchOptions& options);

@@ -3,6 +3,7 @@
 #include "app/bench_command.h"
 #include "app/reference_command.h"
 #include "app/render_command.h"
+#include "app/sweep_command.h"
 #include "renderer/error.h"
 
 #include <CLI/CLI.hpp>
@@ -151,6 +152,32 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   bench->add_flag("--quiet", bo.quiet, "No progress line");
 
+  pdflab::SweepOptions so;
+  CLI::App* sweep =
+      app.add_subcommand("sweep", "Efficiency against the mixture weight of two techniques, at equal time, over seeds");
+  sweep->add_option("--scene", so.scene, "Scene file (JSON)")->required();
+  sweep->add_option("--vary", so.vary, "The two techniques A,B whose shares are swept (e.g. cosine,light)")->required();
+  sweep->add_option("--weights", so.weights, "A's share of the pair as LO:HI:STEP (e.g. 0.1:0.9:0.1)")->required();
+  sweep->add_option("--strategy", so.strategy, "Base mixture: the other techniques keep their weights");
+  sweep->add_option("--seconds", so.seconds, "Render time per run (equal time)")->check(positive_number(" of seconds"));
+  sweep->add_option("--spp", so.spp, "Samples per pixel per run (equal samples)")->check(CLI::Range(1u, 1u << 30));
+  sweep->add_option("--reference", so.reference,
+                    "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
+      ->required();
+  sweep->add_option("--width", so.width, "With --reference auto: image width (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  sweep->add_option("--height", so.height, "With --reference auto: image height (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  sweep->add_option("--cache-dir", so.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
+                                                 "else $XDG_CACHE_HOME/pdflab/references)");
+  sweep->add_option("--seeds", so.seeds, "Runs per weight, for the intervals (default 3)")->check(CLI::Range(1, 1000));
+  sweep->add_option("--seed", so.seed, "First seed (default 2; use one the reference was not rendered with)")
+      ->check(non_negative_integer());
+  sweep->add_option("--csv", so.csv, "One row per weight (CSV)")->required();
+  sweep->add_option("--plot", so.plot, "Efficiency against weight, best weight marked (SVG)");
+  sweep->add_option("--threads", so.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  sweep->add_flag("--quiet", so.quiet, "No progress");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -168,6 +195,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return pdflab::run_render(ro);
     if (bench->parsed()) return pdflab::run_bench(bo);
     if (reference->parsed()) return pdflab::run_reference(fo);
+    if (sweep->parsed()) return pdflab::run_sweep(so);
 #ifdef PDFLAB_HAVE_VIEWER
     pdflab::ViewerOptions vo;
     vo.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;

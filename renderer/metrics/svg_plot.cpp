@@ -146,3 +146,99 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
 }
 
 }  // namespace pdflab
+
+namespace pdflab {
+
+std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions& o) {
+  double y1 = 0.0;
+  for (const auto& s : series)
+    for (std::size_t i = 0; i < s.y.size(); ++i) {
+      if (std::isfinite(s.y[i])) y1 = std::max(y1, s.y[i]);
+      if (i < s.y_hi.size() && std::isfinite(s.y_hi[i])) y1 = std::max(y1, s.y_hi[i]);
+    }
+  if (!(y1 > 0.0)) y1 = 1.0;
+  // A round top: 1, 2 or 5 times a power of ten, five grid lines.
+  const double magnitude = std::pow(10.0, std::floor(std::log10(y1)));
+  double top_value = magnitude;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * magnitude >= y1 * (1.0 + 1e-9)) {
+      top_value = m * magnitude;
+      break;
+    }
+  const double x0 = o.x_min, x1 = o.x_max > o.x_min ? o.x_max : o.x_min + 1.0;
+
+  std::size_t longest = o.marker_label.size();
+  for (const auto& s : series) longest = std::max(longest, s.label.size());
+  const double left = 90, right = std::max(200.0, 60.0 + 7.0 * static_cast<double>(longest)), top = 40, bottom = 60;
+  const double pw = o.width - left - right, ph = o.height - top - bottom;
+  auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * pw; };
+  auto py = [&](double y) { return top + (1.0 - y / top_value) * ph; };
+
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
+                    std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+         escape(o.title) + "</text>\n";
+  if (std::isfinite(o.marker_x)) {
+    const double a = px(std::clamp(o.marker_lo, x0, x1)), b = px(std::clamp(o.marker_hi, x0, x1));
+    svg += "<rect x=\"" + fmt("%.1f", std::min(a, b)) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" +
+           fmt("%.1f", std::fabs(b - a)) + "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"#fde9b8\"/>\n";
+  }
+  for (int k = 0; k <= 10; ++k) {
+    const double xv = x0 + (x1 - x0) * k / 10.0, x = px(xv);
+    svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
+           fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
+           fmt("%.3g", xv) + "</text>\n";
+  }
+  for (int k = 0; k <= 5; ++k) {
+    const double yv = top_value * k / 5.0, y = py(yv);
+    svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
+           "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" +
+           fmt("%.3g", yv) + "</text>\n";
+  }
+  svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
+         "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
+  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"" + fmt("%.1f", o.height - 15.0) +
+         "\" text-anchor=\"middle\">" + escape(o.x_label) + "</text>\n";
+  svg += "<text transform=\"translate(20," + fmt("%.1f", top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
+         escape(o.y_label) + "</text>\n";
+
+  double legend_y = top + 10;
+  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) {
+    svg += "<line x1=\"" + fmt("%.1f", left + pw + 15) + "\" y1=\"" + fmt("%.1f", legend_y) + "\" x2=\"" +
+           fmt("%.1f", left + pw + 40) + "\" y2=\"" + fmt("%.1f", legend_y) + "\" stroke=\"" + colour +
+           "\" stroke-width=\"2\"" + (dashed ? " stroke-dasharray=\"5,4\"" : "") + "/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left + pw + 45) + "\" y=\"" + fmt("%.1f", legend_y + 4) + "\">" + escape(label) +
+           "</text>\n";
+    legend_y += 20;
+  };
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const auto& s = series[k];
+    const std::string colour = kColours[k % (sizeof kColours / sizeof kColours[0])];
+    std::string points;
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      const std::string cx = fmt("%.1f", px(s.x[i])), cy = fmt("%.1f", py(s.y[i]));
+      points += cx + "," + cy + " ";
+      if (i < s.y_lo.size() && i < s.y_hi.size() && std::isfinite(s.y_lo[i]) && std::isfinite(s.y_hi[i]))
+        svg += "<line x1=\"" + cx + "\" y1=\"" + fmt("%.1f", py(std::max(0.0, s.y_lo[i]))) + "\" x2=\"" + cx +
+               "\" y2=\"" + fmt("%.1f", py(s.y_hi[i])) + "\" stroke=\"" + colour + "\" stroke-width=\"1.2\"/>\n";
+      if (!s.dashed) svg += "<circle cx=\"" + cx + "\" cy=\"" + cy + "\" r=\"3\" fill=\"" + colour + "\"/>\n";
+    }
+    svg += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\"" +
+           (s.dashed ? " stroke-dasharray=\"6,4\"" : "") + " points=\"" + points + "\"/>\n";
+    legend(colour, s.label, s.dashed);
+  }
+  if (std::isfinite(o.marker_x)) {
+    const std::string x = fmt("%.1f", px(std::clamp(o.marker_x, x0, x1)));
+    svg += "<line x1=\"" + x + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + x + "\" y2=\"" + fmt("%.1f", top + ph) +
+           "\" stroke=\"#b8860b\" stroke-width=\"2\"/>\n";
+    legend("#b8860b", o.marker_label, false);
+  }
+  svg += "</svg>\n";
+  return svg;
+}
+
+}  // namespace pdflab

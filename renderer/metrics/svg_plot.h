@@ -1,5 +1,6 @@
 #pragma once
 // A small log-log line plot as a standalone SVG document (convergence curves).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -8,6 +9,9 @@ namespace pdflab {
 struct PlotSeries {
   std::string label;
   std::vector<double> x, y;  // points with x <= 0 or y <= 0 are skipped (log axes)
+  // Linear plots only: an error bar per point (empty: none), a dashed line.
+  std::vector<double> y_lo, y_hi;
+  bool dashed = false;
 };
 
 struct PlotOptions {
@@ -16,8 +20,16 @@ struct PlotOptions {
   double guide_slope = 0.0;
   std::string guide_label;
   int width = 720, height = 480;
+  // Linear plots only: a vertical marker at marker_x with a shaded band
+  // [marker_lo, marker_hi] and its label; none when marker_x is NaN.
+  double marker_x = std::numeric_limits<double>::quiet_NaN();
+  double marker_lo = 0.0, marker_hi = 0.0;
+  std::string marker_label;
+  double x_min = 0.0, x_max = 1.0;  // linear x range
 };
 
 std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions& options);
+// Linear axes: x over [x_min, x_max], y from 0 to the largest value (error bars included).
+std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions& options);
 
 }  // namespace pdflab

@@ -1,0 +1,371 @@
+#include "app/sweep_command.h"
+
+#include "app/bench_command.h"
+#include "renderer/error.h"
+#include "renderer/film/image_io.h"
+#include "renderer/metrics/metrics.h"
+#include "renderer/metrics/svg_plot.h"
+#include "renderer/scene/scene_loader.h"
+#include "renderer/session/session.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pdflab {
+
+namespace {
+
+constexpr int kMaxWeights = 201;
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.erase(s.begin());
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.pop_back();
+  return s;
+}
+
+double parse_number(const std::string& text, const std::string& what) {
+  double v = 0.0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+    throw InputError("--weights: " + what + " '" + text + "' is not a number");
+  return v;
+}
+
+// LO:HI:STEP, both ends inside [0, 1]; HI is included when the steps reach it.
+std::vector<double> parse_weights(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, ':')) parts.push_back(trim(part));
+  if (parts.size() != 3 || text.back() == ':')
+    throw InputError("--weights '" + text + "' is not LO:HI:STEP (for example 0:1:0.1)");
+  const double lo = parse_number(parts[0], "LO"), hi = parse_number(parts[1], "HI"),
+               step = parse_number(parts[2], "STEP");
+  if (lo < 0.0 || hi > 1.0) throw InputError("--weights '" + text + "': the weights must lie in [0, 1]");
+  if (!(lo < hi)) throw InputError("--weights '" + text + "': LO must be less than HI");
+  if (!(step > 0.0)) throw InputError("--weights '" + text + "': STEP must be positive");
+  const double steps = (hi - lo) / step;
+  if (steps + 1.0 > kMaxWeights)
+    throw InputError("--weights '" + text + "' gives more than " + std::to_string(kMaxWeights) + " weights");
+  const int n = static_cast<int>(std::floor(steps + 1e-9)) + 1;
+  if (n < 2) throw InputError("--weights '" + text + "': STEP is larger than HI - LO (a sweep needs two weights)");
+  std::vector<double> out;
+  for (int i = 0; i < n; ++i) out.push_back(std::min(hi, lo + step * i));
+  return out;
+}
+
+// A strategy's canonical text as (technique, weight) pairs: "cosine" or
+// "mix:cosine=0.25,light=0.75". The text, not the strategy's fields, so the
+// sweep needs nothing of how a strategy stores its weights.
+std::vector<std::pair<std::string, double>> mixture_terms(const Strategy& s) {
+  const std::string text = s.to_string();
+  if (text.rfind("mix:", 0) != 0) return {{text, 1.0}};
+  std::vector<std::pair<std::string, double>> terms;
+  std::stringstream ss(text.substr(4));
+  std::string term;
+  while (std::getline(ss, term, ',')) {
+    const std::size_t eq = term.find('=');
+    terms.emplace_back(term.substr(0, eq), std::stod(term.substr(eq + 1)));
+  }
+  return terms;
+}
+
+struct Family {
+  std::string a, b;
+  double share = 1.0;                                 // the pair's total weight
+  std::vector<std::pair<std::string, double>> rest;  // the others, normalised weights
+
+  Strategy at(double w) const {
+    char buf[64];
+    std::string text = "mix:";
+    std::snprintf(buf, sizeof buf, "%s=%.9g,%s=%.9g", a.c_str(), share * w, b.c_str(), share * (1.0 - w));
+    text += buf;
+    for (const auto& [name, weight] : rest) {
+      std::snprintf(buf, sizeof buf, ",%s=%.9g", name.c_str(), weight);
+      text += buf;
+    }
+    return Strategy::parse(text);
+  }
+};
+
+Family parse_family(const std::string& vary, const std::string& base) {
+  const std::size_t comma = vary.find(',');
+  if (comma == std::string::npos || vary.find(',', comma + 1) != std::string::npos)
+    throw InputError("--vary '" + vary + "' is not two techniques A,B (for example cosine,light)");
+  Family f;
+  for (std::string* name : {&f.a, &f.b}) {
+    *name = trim(name == &f.a ? vary.substr(0, comma) : vary.substr(comma + 1));
+    Strategy s;
+    try {
+      s = Strategy::parse(*name);
+    } catch (const InputError& e) {  // an unknown name: the message lists the known ones
+      throw InputError("--vary '" + vary + "': " + e.what());
+    }
+    if (s.nee_mis || s.to_string().rfind("mix:", 0) == 0)
+      throw InputError("--vary '" + vary + "': '" + *name + "' is not a mixture technique");
+    *name = s.to_string();  // canonical, as the base mixture's terms are written
+  }
+  if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
+  if (base.empty()) return f;
+  const Strategy s = Strategy::parse(base);
+  if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
+  double pair = 0.0;
+  for (const auto& [name, weight] : mixture_terms(s))
+    if (name == f.a || name == f.b)
+      pair += weight;
+    else
+      f.rest.emplace_back(name, weight);
+  if (!(pair > 0.0))
+    throw InputError("--strategy '" + base + "' gives " + f.a + " and " + f.b +
+                     " no weight: the sweep would hold them at zero");
+  f.share = pair;
+  return f;
+}
+
+// Two-sided 97.5 % quantiles of Student's t for 1..30 degrees of freedom.
+double t_quantile(int dof) {
+  static constexpr double kT[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+                                  2.201,  2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
+                                  2.080,  2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
+  if (dof < 1) return 0.0;
+  return dof <= 30 ? kT[dof - 1] : 1.96;
+}
+
+// Mean and the half-width of its 95 % confidence interval over seeds.
+// Every quantity here is positive, so the lower bound stops at 0.
+struct Interval {
+  double mean = 0.0, half = 0.0;
+  double lo() const { return std::max(0.0, mean - half); }
+  double hi() const { return mean + half; }
+};
+Interval interval(const std::vector<double>& v) {
+  Interval r;
+  if (v.empty()) return r;
+  for (double x : v) r.mean += x;
+  r.mean /= static_cast<double>(v.size());
+  if (v.size() < 2) return r;
+  double ss = 0.0;
+  for (double x : v) ss += (x - r.mean) * (x - r.mean);
+  const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1));
+  r.half = t_quantile(static_cast<int>(v.size()) - 1) * sd / std::sqrt(static_cast<double>(v.size()));
+  return r;
+}
+
+struct Run {
+  std::uint32_t spp = 0;
+  double seconds = 0.0, relmse = 0.0, efficiency = 0.0, samples_per_second = 0.0;
+};
+
+Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
+                const SweepOptions& o, const Reference& reference, const std::string& label,
+                bool show_progress) {
+  RenderSession session(o.threads);
+  RenderSettings settings;
+  settings.scene = scene;
+  settings.strategy = strategy;
+  settings.seed = seed;
+  settings.target_spp = o.spp;  // 0 with --seconds: until paused
+  session.set_settings(settings);
+  for (;;) {
+    const bool done = session.wait_until_done(std::chrono::milliseconds(25));
+    const SessionStats st = session.stats();
+    if (show_progress) {
+      const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
+      std::fprintf(stderr, "\r%s %5.1f%%  %u spp   ", label.c_str(), 100.0 * std::min(1.0, frac), st.spp);
+      std::fflush(stderr);
+    }
+    if (done) break;
+    if (o.seconds > 0 && st.seconds >= o.seconds) {
+      session.set_paused(true);
+      break;
+    }
+  }
+  const Film film = session.copy_film();  // waits for the pass in flight
+  const SessionStats st = session.stats();
+  Run r;
+  r.spp = st.spp;
+  r.seconds = st.seconds;
+  // Corrected for the reference's own noise when it has a variance (as bench does).
+  r.relmse = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance).corrected;
+  r.efficiency = efficiency(r.relmse, r.seconds);
+  r.samples_per_second = st.samples_per_second;
+  return r;
+}
+
+struct Row {
+  double weight = 0.0;
+  Strategy strategy;
+  bool unbiased = true;
+  std::uint32_t spp = 0;  // the first seed's
+  Interval seconds, relmse, efficiency, samples_per_second;
+};
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+int run_sweep(const SweepOptions& o) {
+  if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
+    throw InputError("--seconds must be a positive number of seconds");
+  if ((o.seconds > 0) == (o.spp > 0)) throw InputError("give exactly one of --seconds (equal time) and --spp (equal samples)");
+  if (o.seeds < 1 || o.seeds > 1000) throw InputError("--seeds must be in 1..1000");
+  if (o.threads < 0) throw InputError("--threads must be >= 0");
+  check_output_path(o.csv);
+  if (!o.plot.empty()) check_output_path(o.plot);
+  check_distinct_outputs({o.csv, o.plot});
+  const std::vector<double> weights = parse_weights(o.weights);
+  const Family family = parse_family(o.vary, o.strategy);
+  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
+  // Every strategy of the sweep is checked against the scene before the first render.
+  std::vector<Row> rows;
+  for (double w : weights) {
+    Row r;
+    r.weight = w;
+    r.strategy = family.at(w);
+    (void)SamplingPlan::make(r.strategy, *scene);
+    r.unbiased = r.strategy.is_unbiased();
+    rows.push_back(r);
+  }
+  std::vector<std::uint64_t> seeds;
+  for (int k = 0; k < o.seeds; ++k) seeds.push_back(o.seed + static_cast<std::uint64_t>(k));
+  std::vector<Strategy> strategies;
+  for (const Row& r : rows) strategies.push_back(r.strategy);
+  const Reference reference =
+      comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height}, strategies, seeds, o.quiet);
+
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  const bool show_progress = !o.quiet && tty;
+  const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
+  std::size_t done_runs = 0;
+  for (Row& r : rows) {
+    std::vector<double> seconds, rel, eff, sps;
+    for (int k = 0; k < o.seeds; ++k) {
+      char label[96];
+      std::snprintf(label, sizeof label, "[%zu/%zu] %s=%.3g seed %d/%d", ++done_runs, total, family.a.c_str(), r.weight,
+                    k + 1, o.seeds);
+      const Run run = render_once(scene, r.strategy, seeds[static_cast<std::size_t>(k)], o, reference, label,
+                                  show_progress);
+      if (k == 0) r.spp = run.spp;
+      seconds.push_back(run.seconds);
+      rel.push_back(run.relmse);
+      eff.push_back(run.efficiency);
+      sps.push_back(run.samples_per_second);
+      if (!o.quiet && !tty)
+        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, run.spp, run.seconds,
+                     run.relmse, run.efficiency);
+    }
+    r.seconds = interval(seconds);
+    r.relmse = interval(rel);
+    r.efficiency = interval(eff);
+    r.samples_per_second = interval(sps);
+  }
+  if (show_progress) std::fputc('\n', stderr);
+
+  // The best weight among the unbiased ones (a biased mixture's error stops
+  // falling with time, so its efficiency says nothing about longer runs), and
+  // the weights whose efficiency cannot be told from the best's at 95 %: the
+  // contiguous run around it whose upper bound reaches the best's lower bound.
+  int best = -1;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].unbiased && std::isfinite(rows[i].efficiency.mean) &&
+        (best < 0 || rows[i].efficiency.mean > rows[static_cast<std::size_t>(best)].efficiency.mean))
+      best = static_cast<int>(i);
+  int band_lo = best, band_hi = best;
+  if (best >= 0) {
+    const double floor_value = rows[static_cast<std::size_t>(best)].efficiency.lo();
+    while (band_lo > 0 && rows[static_cast<std::size_t>(band_lo - 1)].unbiased &&
+           rows[static_cast<std::size_t>(band_lo - 1)].efficiency.hi() >= floor_value)
+      --band_lo;
+    while (band_hi + 1 < static_cast<int>(rows.size()) && rows[static_cast<std::size_t>(band_hi + 1)].unbiased &&
+           rows[static_cast<std::size_t>(band_hi + 1)].efficiency.hi() >= floor_value)
+      ++band_hi;
+  }
+  const double best_efficiency = best >= 0 ? rows[static_cast<std::size_t>(best)].efficiency.mean : 0.0;
+
+  // The predicted columns stay empty: predicting needs every technique's pdf at
+  // each path vertex, which the tracers do not record yet.
+  std::string csv =
+      "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
+      "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
+      "predicted_relative_efficiency,best,in_best_interval\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    const int idx = static_cast<int>(i);
+    csv += num(r.weight) + ",\"" + r.strategy.to_string() + "\"," + (r.unbiased ? "1" : "0") + "," +
+           std::to_string(o.seeds) + "," + std::to_string(r.spp) + "," + num(r.seconds.mean) + "," +
+           num(r.relmse.mean) + "," + num(r.relmse.lo()) + "," + num(r.relmse.hi()) + "," + num(r.efficiency.mean) +
+           "," + num(r.efficiency.lo()) + "," + num(r.efficiency.hi()) + "," +
+           num(best_efficiency > 0 ? r.efficiency.mean / best_efficiency : std::nan("")) + "," +
+           num(r.samples_per_second.mean) + "," + num(r.samples_per_second.lo()) + "," +
+           num(r.samples_per_second.hi()) + ",,," + (idx == best ? "1" : "0") + "," +
+           (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "\n";
+  }
+
+  std::string plot;
+  if (!o.plot.empty()) {
+    PlotSeries measured;
+    measured.label = "measured (95% interval over " + std::to_string(o.seeds) + " seeds)";
+    for (const Row& r : rows) {
+      if (!r.unbiased) continue;
+      measured.x.push_back(r.weight);
+      measured.y.push_back(r.efficiency.mean);
+      measured.y_lo.push_back(r.efficiency.lo());
+      measured.y_hi.push_back(r.efficiency.hi());
+    }
+    PlotOptions po;
+    po.title = "Efficiency against the weight of " + family.a + " (vs " + family.b + "): " + scene->name;
+    po.x_label = "weight of " + family.a + " (share of " + family.a + " + " + family.b + ")";
+    po.y_label = "efficiency = 1 / (relMSE * seconds)";
+    po.width = 900;
+    po.height = 520;
+    po.x_min = weights.front();
+    po.x_max = weights.back();
+    if (best >= 0) {
+      po.marker_x = rows[static_cast<std::size_t>(best)].weight;
+      po.marker_lo = rows[static_cast<std::size_t>(band_lo)].weight;
+      po.marker_hi = rows[static_cast<std::size_t>(band_hi)].weight;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "best %.3g (band %.3g..%.3g)", po.marker_x, po.marker_lo, po.marker_hi);
+      po.marker_label = buf;
+    }
+    plot = linear_svg({measured}, po);
+  }
+  write_file_atomic(o.csv, {reinterpret_cast<const std::uint8_t*>(csv.data()), csv.size()});
+  if (!o.plot.empty()) write_file_atomic(o.plot, {reinterpret_cast<const std::uint8_t*>(plot.data()), plot.size()});
+
+  std::printf("%-8s %-40s %6s %10s %22s %10s %9s\n", "weight", "strategy", "spp", "relmse", "efficiency (95%)",
+              "vs best", "Msamp/s");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    char eff[64];
+    std::snprintf(eff, sizeof eff, "%.4g +- %.2g", r.efficiency.mean, r.efficiency.half);
+    std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(), r.spp,
+                r.relmse.mean, eff, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
+                r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
+                static_cast<int>(i) == best ? "  <- best" : "");
+  }
+  if (best >= 0)
+    std::printf("best weight of %s: %.3g; indistinguishable at 95%%: %.3g..%.3g\n", family.a.c_str(),
+                rows[static_cast<std::size_t>(best)].weight, rows[static_cast<std::size_t>(band_lo)].weight,
+                rows[static_cast<std::size_t>(band_hi)].weight);
+  else
+    std::printf("no weight of the sweep gives an unbiased mixture\n");
+  return 0;
+}
+
+}  // namespace pdflab

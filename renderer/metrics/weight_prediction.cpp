@@ -1,0 +1,152 @@
+#include "renderer/metrics/weight_prediction.h"
+
+#include "renderer/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pdflab {
+
+std::vector<double> weight_grid(int points) {
+  std::vector<double> grid;
+  if (points < 2) return {0.5};
+  for (int i = 0; i < points; ++i) grid.push_back(static_cast<double>(i) / static_cast<double>(points - 1));
+  return grid;
+}
+
+double defended_weight(double w, double floor) { return std::clamp(w, floor, 1.0 - floor); }
+
+WeightPredictor::WeightPredictor(int cells, std::vector<double> grid, double sampling_weight, WeightFamily family)
+    : cells_(cells), grid_(std::move(grid)), w_(sampling_weight), family_(family) {
+  if (cells_ < 1 || grid_.empty() || !(family_.share > 0.0 && family_.share <= 1.0))
+    throw InputError("weight prediction needs at least one cell, one grid weight and a share in (0, 1]");
+  count_.assign(static_cast<std::size_t>(cells_), 0);
+  moment_.assign(static_cast<std::size_t>(cells_) * grid_.size() * 3, 0.0);
+  cost_sum_.assign(grid_.size(), 0.0);
+  offset_sum_.assign(grid_.size(), 0.0);
+  ratio_.assign(grid_.size(), 1.0);
+}
+
+void WeightPredictor::clear() {
+  std::fill(count_.begin(), count_.end(), 0);
+  std::fill(moment_.begin(), moment_.end(), 0.0);
+  std::fill(cost_sum_.begin(), cost_sum_.end(), 0.0);
+  std::fill(offset_sum_.begin(), offset_sum_.end(), 0.0);
+  plain_cost_sum_ = 0.0;
+  paths_ = 0;
+}
+
+void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const MixtureVertex> vertices, double cost) {
+  if (cell < 0 || cell >= cells_) return;
+  const std::size_t grid_size = grid_.size();
+  // R(w') = prod_k p_w(k) / p_w'(k). A vertex whose direction has density 0 at
+  // w' makes R infinite: at w' the path could not have been drawn.
+  std::fill(ratio_.begin(), ratio_.end(), 1.0);
+  for (const MixtureVertex& v : vertices) {
+    const double here = family_.pdf(v, w_);
+    for (std::size_t g = 0; g < grid_size; ++g) {
+      const double there = family_.pdf(v, grid_[g]);
+      ratio_[g] *= there > 0.0 ? here / there : std::numeric_limits<double>::infinity();
+    }
+  }
+  double* moment = &moment_[(static_cast<std::size_t>(cell) * grid_size) * 3];
+  for (std::size_t g = 0; g < grid_size; ++g) {
+    const double r = ratio_[g];
+    for (int c = 0; c < 3; ++c) {
+      const double f = static_cast<double>(rgb[c]);
+      if (f != 0.0) moment[g * 3 + static_cast<std::size_t>(c)] += f * f * r;  // 0 * inf stays out
+    }
+    const double inverse = 1.0 / r;  // 0 for an infinite ratio
+    cost_sum_[g] += cost * inverse;
+    offset_sum_[g] += inverse;
+  }
+  plain_cost_sum_ += cost;
+  ++count_[static_cast<std::size_t>(cell)];
+  ++paths_;
+}
+
+void WeightPredictor::merge(const WeightPredictor& o) {
+  if (o.cells_ != cells_ || o.grid_ != grid_ || o.w_ != w_ || o.family_.share != family_.share)
+    throw InputError("weight predictors with different cells, grids or weights cannot be merged");
+  for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
+  for (std::size_t i = 0; i < moment_.size(); ++i) moment_[i] += o.moment_[i];
+  for (std::size_t g = 0; g < grid_.size(); ++g) cost_sum_[g] += o.cost_sum_[g], offset_sum_[g] += o.offset_sum_[g];
+  plain_cost_sum_ += o.plain_cost_sum_;
+  paths_ += o.paths_;
+}
+
+double WeightPredictor::second_moment(int cell, std::size_t g, int channel) const {
+  const std::uint64_t n = count_[static_cast<std::size_t>(cell)];
+  if (n == 0) return 0.0;
+  return moment_[(static_cast<std::size_t>(cell) * grid_.size() + g) * 3 + static_cast<std::size_t>(channel)] /
+         static_cast<double>(n);
+}
+
+WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, double seconds_per_sample, double epsilon,
+                                          double cost_offset, const std::vector<float>* mean_square_rgb) const {
+  if (mean_rgb.size() != static_cast<std::size_t>(cells_) * 3 ||
+      (mean_square_rgb && mean_square_rgb->size() != mean_rgb.size()))
+    throw InputError("weight prediction: the mean image does not have one RGB value per cell");
+  WeightPrediction p;
+  p.weight = grid_;
+  p.paths = paths_;
+  const std::size_t grid_size = grid_.size();
+  p.relative_variance.assign(grid_size, 0.0);
+  p.cost.assign(grid_size, 0.0);
+  p.efficiency.assign(grid_size, 0.0);
+  std::size_t terms = 0;
+  for (int cell = 0; cell < cells_; ++cell) {
+    if (count_[static_cast<std::size_t>(cell)] == 0) continue;
+    for (int c = 0; c < 3; ++c) {
+      const std::size_t i = static_cast<std::size_t>(cell) * 3 + static_cast<std::size_t>(c);
+      const double mu = static_cast<double>(mean_rgb[i]);
+      const double mu2 = mean_square_rgb ? static_cast<double>((*mean_square_rgb)[i]) : mu * mu;
+      // relMSE's denominator is r^2 + eps with r the pixel's value; for a block, its mean.
+      const double denominator = mu * mu + epsilon;
+      for (std::size_t g = 0; g < grid_size; ++g)
+        p.relative_variance[g] += std::max(0.0, second_moment(cell, g, c) - mu2) / denominator;
+      ++terms;
+    }
+  }
+  if (terms == 0 || paths_ == 0) return p;
+  // Cost at w' self-normalised by the mean of 1/R (whose expectation is 1): the
+  // ratio estimate has less noise than the plain mean when R varies a lot. The
+  // measured time per sample belongs to the plain mean cost at the sampling weight.
+  const double cost_here = plain_cost_sum_ / static_cast<double>(paths_);
+  double best = -1.0;
+  for (std::size_t g = 0; g < grid_size; ++g) {
+    p.relative_variance[g] /= static_cast<double>(terms);
+    p.cost[g] = offset_sum_[g] > 0.0 ? cost_sum_[g] / offset_sum_[g] : std::numeric_limits<double>::infinity();
+    const double time_scale =
+        seconds_per_sample > 0.0 && cost_here + cost_offset > 0.0
+            ? seconds_per_sample * (p.cost[g] + cost_offset) / (cost_here + cost_offset)
+            : p.cost[g] + cost_offset;
+    const double denominator = p.relative_variance[g] * time_scale;
+    p.efficiency[g] = std::isfinite(denominator) && denominator > 0.0 ? 1.0 / denominator : 0.0;
+    if (p.efficiency[g] > best) best = p.efficiency[g], p.best = static_cast<int>(g);
+  }
+  if (!(best > 0.0)) p.best = -1;
+  return p;
+}
+
+std::vector<float> WeightPredictor::best_weight_map(const std::vector<float>& mean_rgb, double epsilon) const {
+  if (mean_rgb.size() != static_cast<std::size_t>(cells_) * 3)
+    throw InputError("weight prediction: the mean image does not have one RGB value per cell");
+  std::vector<float> map(static_cast<std::size_t>(cells_), -1.0f);
+  for (int cell = 0; cell < cells_; ++cell) {
+    if (count_[static_cast<std::size_t>(cell)] == 0) continue;
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t g = 0; g < grid_.size(); ++g) {
+      double m = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        const double mu = static_cast<double>(mean_rgb[static_cast<std::size_t>(cell) * 3 + static_cast<std::size_t>(c)]);
+        m += second_moment(cell, g, c) / (mu * mu + epsilon);
+      }
+      if (m < least) least = m, map[static_cast<std::size_t>(cell)] = static_cast<float>(grid_[g]);
+    }
+  }
+  return map;
+}
+
+}  // namespace pdflab

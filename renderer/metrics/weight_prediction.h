@@ -1,0 +1,121 @@
+#pragma once
+// Where should the mixture weight be? A prediction of the second moment, the
+// cost and the efficiency of a one-sample mixture at every weight of a grid,
+// from paths drawn at one weight.
+//
+// The mixture varies the share of two techniques A and B; the others keep
+// their weights. At a diffuse vertex whose drawn direction has density a under
+// A, b under B and r = sum over the other techniques of w_i p_i, the mixture's
+// density at weight w (A's share of the pair, which has total weight s) is
+//
+//     p_w = s (w a + (1 - w) b) + r.
+//
+// A path's pdf is the product of p_w over its diffuse vertices (the tracer has
+// no Russian roulette; specular bounces do not depend on w). For a path drawn
+// at w with estimate F_w = f / prod p_w, the same path at w' would have
+// estimated F_w' = F_w R with R = prod_k p_w(k) / p_w'(k), and
+//
+//     M(w') = E_w'[F_w'^2] = E_w[F_w'^2 prod_k p_w'(k) / p_w(k)] = E_w[F_w^2 R]
+//     C(w') = E_w'[cost]   = E_w[cost / R]
+//
+// are both estimated without bias from the paths at w. With a pixel's mean mu
+// (which does not depend on w), its variance at w' is M(w') - mu^2, and the
+// image-wide relative variance is the mean over pixels and channels of
+// variance / (mu^2 + epsilon), the relMSE of one sample per pixel. At equal
+// time the relMSE scales with the time per sample, which scales with C(w'):
+// efficiency(w') = 1 / (relative variance(w') * seconds per sample(w')).
+//
+// R is bounded only while w stays away from 0 and 1: p_w'/p_w <= max(w'/w,
+// (1-w')/(1-w)) for the pair's share. A weight near 0 or 1 makes the estimate
+// of M at the far end of the grid heavy-tailed, so the sampling weight is kept
+// inside [floor, 1 - floor] while predicting (kDefensiveFloor).
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+
+inline constexpr double kDefensiveFloor = 0.05;
+
+// Densities at one diffuse vertex for the direction it drew.
+struct MixtureVertex {
+  float a = 0.0f;     // technique A's pdf
+  float b = 0.0f;     // technique B's pdf
+  float rest = 0.0f;  // sum of w_i p_i over the techniques that are not varied
+};
+
+// The family of mixtures: A's share w of the pair whose total weight is `share`.
+struct WeightFamily {
+  double share = 1.0;  // wA + wB of the normalised weights, in (0, 1]
+  double pdf(const MixtureVertex& v, double w) const {
+    return share * (w * static_cast<double>(v.a) + (1.0 - w) * static_cast<double>(v.b)) + static_cast<double>(v.rest);
+  }
+};
+
+// The grid of weights w' the prediction covers: `points` evenly spaced on [0, 1].
+std::vector<double> weight_grid(int points);
+
+// Clamps a weight into [floor, 1 - floor].
+double defended_weight(double w, double floor = kDefensiveFloor);
+
+struct WeightPrediction {
+  std::vector<double> weight;           // the grid
+  std::vector<double> relative_variance;  // mean over pixels and channels of var / (mu^2 + eps), one sample each
+  std::vector<double> cost;             // expected cost of a path (segments traced)
+  std::vector<double> efficiency;       // 1 / (relative_variance * seconds per sample); 0 where infinite variance
+  std::uint64_t paths = 0;
+  int best = -1;                        // index of the highest efficiency; -1 when none is finite
+  double best_weight() const { return best >= 0 ? weight[static_cast<std::size_t>(best)] : -1.0; }
+};
+
+// Accumulates paths drawn at one sampling weight, per cell (a pixel, or a block
+// of pixels), and predicts over the grid. Not thread-safe: give each thread its
+// own and merge() them.
+class WeightPredictor {
+ public:
+  // `cells`: how many cells paths are filed under. `sampling_weight`: the w the
+  // paths are drawn at. `grid`: the w' to predict at.
+  WeightPredictor(int cells, std::vector<double> grid, double sampling_weight, WeightFamily family);
+
+  // One path: its estimate (RGB) at the sampling weight, the densities at each
+  // of its diffuse vertices, its cost (e.g. the number of rays it traced).
+  void add_path(int cell, const float rgb[3], std::span<const MixtureVertex> vertices, double cost);
+  void merge(const WeightPredictor& other);  // same cells, grid, weight and family
+  void clear();
+
+  // The prediction. `mean_rgb` holds each cell's mean (from a reference or the
+  // film, 3 floats a cell; for a block cell, `mean_square_rgb` may give the
+  // block's mean of mu^2 per channel, otherwise mean_rgb^2 is used).
+  // `seconds_per_sample` is the measured time per path at the sampling weight
+  // (0: efficiency in units of 1 / (relative variance * cost)). `cost_offset`
+  // is the per-path cost that does not scale with the path's length.
+  WeightPrediction predict(const std::vector<float>& mean_rgb, double seconds_per_sample, double epsilon,
+                           double cost_offset = 0.0, const std::vector<float>* mean_square_rgb = nullptr) const;
+
+  // Per cell, the grid weight with the least predicted second moment (summed
+  // over channels, relative to mu^2 + eps); -1 for a cell without paths.
+  std::vector<float> best_weight_map(const std::vector<float>& mean_rgb, double epsilon) const;
+
+  // The second moment per channel of one cell at grid point g (0 without paths).
+  double second_moment(int cell, std::size_t g, int channel) const;
+  std::uint64_t cell_paths(int cell) const { return count_[static_cast<std::size_t>(cell)]; }
+  const std::vector<double>& grid() const { return grid_; }
+  double sampling_weight() const { return w_; }
+  std::uint64_t paths() const { return paths_; }
+
+ private:
+  int cells_;
+  std::vector<double> grid_;
+  double w_;
+  WeightFamily family_;
+  std::vector<std::uint64_t> count_;   // per cell
+  std::vector<double> moment_;         // per cell, grid point and channel: sum of F^2 R
+  std::vector<double> cost_sum_;       // per grid point: sum of cost / R
+  std::vector<double> offset_sum_;     // per grid point: sum of 1 / R (should approach the path count)
+  double plain_cost_sum_ = 0.0;        // sum of cost, at the sampling weight
+  std::vector<double> ratio_;          // scratch: R per grid point for the path being added
+  std::uint64_t paths_ = 0;
+};
+
+}  // namespace pdflab
