@@ -84,13 +84,24 @@ int main(int argc, char** argv) {
 
   pdflab::RenderOptions ro;
   CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
-  render->add_option("--scene", ro.scene, "Scene file (JSON)")->required();
-  render->add_option("--strategy", ro.strategy, "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5")
-      ->required();
-  render->add_option("--spp", ro.spp, "Samples per pixel")->required()->check(CLI::Range(1u, 1u << 30));
-  render->add_option("--out", ro.out, "Output image: .png (tone-mapped), .pfm (linear), .hdr")->required();
-  render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)")
+  CLI::Option* scene_option = render->add_option("--scene", ro.scene, "Scene file (JSON); with --resume, default: the film's");
+  CLI::Option* strategy_option = render->add_option("--strategy", ro.strategy,
+                     "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5; with --resume, default: the film's");
+  CLI::Option* spp_option =
+      render->add_option("--spp", ro.spp, "Samples per pixel (with --resume: in all, those in the film included)")
+          ->check(CLI::Range(1u, 1u << 30));
+  CLI::Option* out_option = render->add_option("--out", ro.out, "Output image: .png (tone-mapped), .pfm (linear), .hdr, .exr (linear, with variance and count layers)");
+  CLI::Option* seed_option = render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)")
       ->check(non_negative_integer());
+  CLI::Option* first_option =
+      render->add_option("--first-sample", ro.first_sample,
+                         "Index of the first sample of each pixel (default 0): renders of disjoint ranges merge")
+          ->check(CLI::Range(0u, 0xffffffffu));
+  render->add_option("--film-out", ro.film_out, "Also save the accumulation as a film file (for --resume and merge)");
+  render->add_option("--resume", ro.resume, "Continue this film file (saved to it again unless --film-out says otherwise)");
+  render->add_option("--checkpoint-seconds", ro.checkpoint_seconds,
+                     "With a film file: save it this often while rendering (default 60; 0: only at the end)")
+      ->check(CLI::Range(0.0, 1e9));
   render->add_option("--threads", ro.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   render->add_option("--width", ro.width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   render->add_option("--height", ro.height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
@@ -125,6 +136,15 @@ int main(int argc, char** argv) {
                                                      "else $XDG_CACHE_HOME/pdflab/references)");
   reference->add_option("--threads", fo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   reference->add_flag("--quiet", fo.quiet, "No progress bar or notes");
+
+  pdflab::MergeOptions mo;
+  CLI::App* merge = app.add_subcommand("merge", "Add films of one scene and settings with disjoint sample ranges");
+  merge->add_option("films", mo.films, "Film files (from render --film-out)")->required();
+  merge->add_option("--out", mo.out, "Image of the merged estimate: .exr, .pfm, .png or .hdr");
+  merge->add_option("--film-out", mo.film_out, "The merged film");
+  merge->add_option("--stats-json", mo.stats_json, "Also write the summary as JSON");
+  merge->add_option("--transfer", mo.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
+      ->check(CLI::IsMember({"gamma2", "srgb"}));
 
   pdflab::BenchOptions bo;
   CLI::App* bench = app.add_subcommand("bench", "Compare strategies at equal time (or spp) against a reference");
@@ -192,7 +212,16 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (render->parsed()) return pdflab::run_render(ro);
+    if (render->parsed()) {
+      ro.scene_given = scene_option->count() > 0;
+      ro.strategy_given = strategy_option->count() > 0;
+      ro.spp_given = spp_option->count() > 0;
+      ro.out_given = out_option->count() > 0;
+      ro.seed_given = seed_option->count() > 0;
+      ro.first_sample_given = first_option->count() > 0;
+      return pdflab::run_render(ro);
+    }
+    if (merge->parsed()) return pdflab::run_merge(mo);
     if (bench->parsed()) return pdflab::run_bench(bo);
     if (reference->parsed()) return pdflab::run_reference(fo);
     if (sweep->parsed()) return pdflab::run_sweep(so);

@@ -1,24 +1,61 @@
 #include "app/render_command.h"
 
 #include "app/reference_command.h"
-#include "renderer/metrics/metrics.h"
-
 #include "renderer/error.h"
 #include "renderer/film/film.h"
+#include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/metrics/metrics.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
 #include <nlohmann/json.hpp>
+#include <signal.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 
 namespace pdflab {
 
 namespace {
+
+constexpr int kInterrupted = 130;  // the shell's status for a run stopped by Ctrl-C
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+void on_stop_signal(int sig) { g_stop_signal = sig; }
+
+// SIGINT and SIGTERM stop the render between passes (the film is saved when
+// there is one to save); the previous handlers come back on destruction.
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    struct sigaction sa{};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(SIGINT, &sa, &old_int_);
+    ::sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    ::sigaction(SIGINT, &old_int_, nullptr);
+    ::sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+  bool stopped() const { return g_stop_signal != 0; }
+
+ private:
+  struct sigaction old_int_{}, old_term_{};
+};
 
 void draw_progress(const SessionStats& st, std::uint32_t target) {
   constexpr int kWidth = 32;
@@ -32,40 +69,143 @@ void draw_progress(const SessionStats& st, std::uint32_t target) {
   std::fflush(stderr);
 }
 
+Transfer parse_transfer(const std::string& text) {
+  if (text == "gamma2") return Transfer::Gamma2;
+  if (text == "srgb") return Transfer::Srgb;
+  throw InputError("--transfer must be 'gamma2' or 'srgb', not '" + text + "'");
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+}
+
+// What an EXR's header says about the estimate in it.
+std::vector<std::pair<std::string, std::string>> image_attributes(const FilmInfo& info) {
+  char hash[24];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(info.scene_hash));
+  return {{"pdflab.scene", info.scene_file},
+          {"pdflab.sceneHash", hash},
+          {"pdflab.strategy", info.strategy},
+          {"pdflab.spp", std::to_string(info.spp())},
+          {"pdflab.samples", info.ranges_text()},
+          {"pdflab.maxDepth", std::to_string(info.max_depth)},
+          {"pdflab.version", PDFLAB_VERSION}};
+}
+
+nlohmann::json drops_json(const DropCounts& dropped) {
+  nlohmann::json j = {{"total", dropped.total()}};
+  for (int r = 0; r < kDropReasonCount; ++r)
+    j[std::string(drop_reason_name(static_cast<DropReason>(r)))] = dropped.by_reason[static_cast<std::size_t>(r)];
+  return j;
+}
+
+std::string drops_text(const DropCounts& dropped) {
+  const auto& d = dropped.by_reason;
+  char text[160];
+  std::snprintf(text, sizeof text, "%llu samples dropped (pdf_zero %llu, pdf_not_finite %llu, radiance_not_finite %llu)",
+                static_cast<unsigned long long>(dropped.total()), static_cast<unsigned long long>(d[0]),
+                static_cast<unsigned long long>(d[1]), static_cast<unsigned long long>(d[2]));
+  return text;
+}
+
+// The film to continue, checked against what the command line asks for.
+struct Resumed {
+  FilmFile file;
+  std::string scene, strategy;
+};
+
+Resumed open_resume(const RenderOptions& o) {
+  Resumed r{read_film_file(o.resume), o.scene_given ? o.scene : "", o.strategy_given ? o.strategy : ""};
+  const FilmInfo& info = r.file.info;
+  const std::string film = "film '" + o.resume + "'";
+  if (info.ranges.size() != 1)
+    throw InputError("--resume: " + film + " is a merge of " + std::to_string(info.ranges.size()) +
+                     " renders (" + info.ranges_text() + "); only one render's film can be continued");
+  const SampleRange& range = info.ranges.front();
+  if (!o.scene_given) r.scene = info.scene_file;
+  if (!o.strategy_given) r.strategy = info.strategy;
+  else if (Strategy::parse(r.strategy).to_string() != info.strategy)
+    throw InputError("--resume: " + film + " was rendered with strategy '" + info.strategy + "', not '" +
+                     Strategy::parse(r.strategy).to_string() + "'");
+  if (o.seed_given && o.seed != range.seed)
+    throw InputError("--resume: " + film + " was rendered with seed " + std::to_string(range.seed) + ", not " +
+                     std::to_string(o.seed));
+  if (o.first_sample_given && o.first_sample != range.first)
+    throw InputError("--resume: " + film + " starts at sample " + std::to_string(range.first) + ", not " +
+                     std::to_string(o.first_sample));
+  if ((o.width != 0 && o.width != info.width) || (o.height != 0 && o.height != info.height))
+    throw InputError("--resume: " + film + " is " + std::to_string(info.width) + "x" + std::to_string(info.height) +
+                     ", not the size asked for");
+  return r;
+}
+
 }  // namespace
 
 int run_render(const RenderOptions& o) {
   // Everything the user typed is checked before any work starts.
+  if (o.resume.empty() && !o.scene_given) throw InputError("--scene is required (unless --resume names a film)");
+  if (o.resume.empty() && !o.strategy_given) throw InputError("--strategy is required (unless --resume names a film)");
+  if (!o.spp_given) throw InputError("--spp is required");
   if (o.spp == 0) throw InputError("--spp must be at least 1");
-  const ImageFormat format = image_format_for(o.out);
-  (void)format;
-  check_output_path(o.out);
+  if (!o.out_given && o.film_out.empty() && o.resume.empty())
+    throw InputError("nothing to write: give --out IMAGE, --film-out FILM or both");
+  if (o.out_given) {
+    (void)image_format_for(o.out);
+    check_output_path(o.out);
+  }
+  const std::string film_out = o.film_out.empty() ? o.resume : o.film_out;
+  if (!film_out.empty()) check_output_path(film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
-  check_distinct_outputs({o.out, o.stats_json});
-  Transfer transfer;
-  if (o.transfer == "gamma2") transfer = Transfer::Gamma2;
-  else if (o.transfer == "srgb") transfer = Transfer::Srgb;
-  else throw InputError("--transfer must be 'gamma2' or 'srgb', not '" + o.transfer + "'");
+  check_distinct_outputs({o.out, film_out, o.stats_json});
+  const Transfer transfer = parse_transfer(o.transfer);
   if (o.threads < 0 || o.threads > 1024) throw InputError("--threads must be in 0..1024 (0: all cores)");
+  if (!(o.checkpoint_seconds >= 0.0) || !std::isfinite(o.checkpoint_seconds))
+    throw InputError("--checkpoint-seconds must be a number >= 0");
 
-  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
-  if (o.width != 0) scene->camera.width = o.width;
-  if (o.height != 0) scene->camera.height = o.height;
-  if (o.width != 0 || o.height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
+  std::optional<Resumed> resumed;
+  if (!o.resume.empty()) resumed = open_resume(o);
+  const std::string scene_path = resumed ? resumed->scene : o.scene;
+  const std::string strategy_text = resumed ? resumed->strategy : o.strategy;
+
+  auto scene = std::make_shared<Scene>(load_scene_file(scene_path));
+  const int width = resumed ? resumed->file.info.width : o.width;
+  const int height = resumed ? resumed->file.info.height : o.height;
+  if (width != 0) scene->camera.width = width;
+  if (height != 0) scene->camera.height = height;
+  if (width != 0 || height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
   scene->prepare();
-  const Strategy strategy = Strategy::parse(o.strategy);
+  const Strategy strategy = Strategy::parse(strategy_text);
   (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
+
+  FilmInfo info;
+  info.scene_hash = film_scene_hash(*scene);
+  info.scene_file = scene_path;
+  info.width = scene->camera.width;
+  info.height = scene->camera.height;
+  info.max_depth = scene->max_depth;
+  info.strategy = strategy.to_string();
+  const std::uint64_t seed = resumed ? resumed->file.info.ranges.front().seed : o.seed;
+  const std::uint32_t first_sample = resumed ? resumed->file.info.ranges.front().first : o.first_sample;
+  if (std::uint64_t{first_sample} + o.spp > std::numeric_limits<std::uint32_t>::max())
+    throw InputError("--first-sample " + std::to_string(first_sample) + " plus --spp " + std::to_string(o.spp) +
+                     " passes the last sample index (" + std::to_string(std::numeric_limits<std::uint32_t>::max()) + ")");
+  if (resumed) {
+    const FilmInfo& had = resumed->file.info;
+    if (had.scene_hash != info.scene_hash || had.max_depth != info.max_depth)
+      throw InputError("--resume: film '" + o.resume + "' was rendered from another scene than '" + scene_path +
+                       "' (its content or maximum depth differs)");
+  }
 
   // The reference is checked before any rendering: its size, and that the
   // render would not repeat its random numbers.
-  const Reference reference = resolve_reference(o.reference, *scene, o.scene, o.cache_dir, false, o.quiet);
+  const Reference reference = resolve_reference(o.reference, *scene, scene_path, o.cache_dir, false, o.quiet);
   if (reference.loaded()) {
     if (reference.width != scene->camera.width || reference.height != scene->camera.height)
       throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
                        std::to_string(reference.height) + " but the render is " +
                        std::to_string(scene->camera.width) + "x" + std::to_string(scene->camera.height) +
                        " (use --width/--height)");
-    if (const std::string shared = shared_random_numbers(reference.info, o.seed, strategy); !shared.empty())
+    if (const std::string shared = shared_random_numbers(reference.info, seed, strategy); !shared.empty())
       throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
   }
 
@@ -75,23 +215,78 @@ int run_render(const RenderOptions& o) {
                  "targets, so it omits indirect light\n",
                  strategy.to_string().c_str());
 
-  RenderSession session(o.threads);
+  SessionOptions session_options;
+  session_options.threads = o.threads;
+  session_options.publish_images = false;  // the film is read once, at the end
+  RenderSession session(session_options);
   RenderSettings settings;
   settings.scene = scene;
   settings.strategy = strategy;
-  settings.seed = o.seed;
+  settings.seed = seed;
   settings.target_spp = o.spp;
-  session.set_settings(settings);
+  settings.first_sample = first_sample;
+  double seconds_before = 0.0;
+  if (resumed) {
+    FilmFile& file = resumed->file;
+    seconds_before = file.info.seconds;
+    const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
+    const DropCounts had_drops = file.info.dropped;
+    session.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
+  } else {
+    session.set_settings(settings);
+  }
 
+  // The film as it stands between two passes, with what it holds.
+  const auto save_film = [&](const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) {
+    FilmInfo now = info;
+    now.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
+    now.dropped = dropped;
+    now.seconds = seconds_before + seconds;
+    write_film_file(film_out, now, film);
+    return now;
+  };
+  const auto checkpoint = [&] {
+    session.set_paused(true);
+    const double seconds = session.stats().seconds;
+    std::uint32_t saved = 0;
+    session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+      if (spp > 0) save_film(film, spp, dropped, seconds);
+      saved = spp;
+    });
+    return saved;
+  };
+
+  const StopSignals signals;
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
+  using Clock = std::chrono::steady_clock;
+  auto last_checkpoint = Clock::now();
+  const bool checkpoints = !film_out.empty() && o.checkpoint_seconds > 0.0;
   EstimateHistory history;  // is the film's own estimate trustworthy?
-  std::vector<float> pass_image;
-  std::uint64_t pass_version = 0;
+  std::uint32_t history_spp = 0;
+  const auto note_estimate = [&](const SessionStats& now) {
+    if (now.spp > history_spp && now.estimated_relmse > 0.0) history.add(now.spp, now.estimated_relmse);
+    history_spp = std::max(history_spp, now.spp);
+  };
   while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
+    note_estimate(session.stats());
+    if (signals.stopped()) {
+      if (show_progress) std::fputc('\n', stderr);
+      if (film_out.empty()) {
+        std::fprintf(stderr, "pdflab: interrupted; nothing written\n");
+        return kInterrupted;
+      }
+      const std::uint32_t saved = checkpoint();
+      std::fprintf(stderr, "pdflab: interrupted at %u of %u spp; the film '%s' holds them: continue with "
+                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, film_out.c_str(), film_out.c_str(), o.spp);
+      return kInterrupted;
+    }
+    if (checkpoints &&
+        std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= o.checkpoint_seconds) {
+      checkpoint();
+      session.set_paused(false);
+      last_checkpoint = Clock::now();
+    }
     if (show_progress) draw_progress(session.stats(), o.spp);
-    ImageInfo info;
-    if (session.copy_image(pass_image, info, pass_version) && !info.preview)
-      history.add(info.spp, info.estimated_relmse);
   }
   const SessionStats st = session.stats();
   if (show_progress) {
@@ -99,34 +294,42 @@ int run_render(const RenderOptions& o) {
     std::fputc('\n', stderr);
   }
 
-  const Film film = session.copy_film();
-  const std::vector<float> mean = film.mean_rgb();
-  const double estimate = estimated_relmse(film);
-  history.add(st.spp, estimate);
-  write_image(o.out, mean, film.width(), film.height(), transfer);
+  FilmInfo final_info = info;
+  double estimate = 0.0;
   RelMseMeasure error;
-  if (reference.loaded()) error = measure_relmse(mean, reference.rgb, reference.variance);
+  session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+    if (!film_out.empty()) {
+      final_info = save_film(film, spp, dropped, st.seconds);
+    } else {
+      final_info.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
+      final_info.dropped = dropped;
+      final_info.seconds = seconds_before + st.seconds;
+    }
+    if (o.out_given) write_film_image(o.out, film, transfer, image_attributes(final_info));
+    estimate = estimated_relmse(film);
+    if (reference.loaded()) error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
+  });
+  history.add(static_cast<std::uint32_t>(final_info.spp()), estimate);
   const double measured_efficiency = efficiency(error.corrected, st.seconds);
 
-  const auto& d = st.dropped.by_reason;
   if (!o.stats_json.empty()) {
     nlohmann::json j;
     j["scene"] = scene->name;
-    j["scene_file"] = o.scene;
+    j["scene_file"] = scene_path;
     j["strategy"] = strategy.to_string();
     j["unbiased"] = strategy.is_unbiased();
-    j["width"] = film.width();
-    j["height"] = film.height();
-    j["spp"] = st.spp;
-    j["seed"] = o.seed;
+    j["width"] = final_info.width;
+    j["height"] = final_info.height;
+    j["spp"] = final_info.spp();
+    j["seed"] = seed;
+    j["first_sample"] = first_sample;
     j["threads"] = session.thread_count();
     j["seconds"] = st.seconds;
     j["samples"] = st.samples;
     j["samples_per_second"] = st.samples_per_second;
-    j["dropped"] = {{"total", st.dropped.total()}};
-    for (int r = 0; r < kDropReasonCount; ++r)
-      j["dropped"][std::string(drop_reason_name(static_cast<DropReason>(r)))] = d[r];
+    j["dropped"] = drops_json(final_info.dropped);
     j["output"] = o.out;
+    if (!film_out.empty()) j["film"] = film_out;
     // The film's own estimate is a lower bound: it cannot see what the samples never found.
     j["est_relmse"] = estimate;
     j["est_relmse_unreliable"] = history.unreliable();
@@ -140,15 +343,14 @@ int run_render(const RenderOptions& o) {
       j["reference_share"] = error.reference_share();
       j["efficiency"] = measured_efficiency;
     }
-    const std::string text = j.dump(2) + "\n";
-    write_file_atomic(o.stats_json, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    write_text(o.stats_json, j.dump(2) + "\n");
   }
 
-  std::printf("%u spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %llu samples dropped "
-              "(pdf_zero %llu, pdf_not_finite %llu, radiance_not_finite %llu) -> %s\n",
-              st.spp, film.width(), film.height(), st.seconds, st.samples_per_second * 1e-6, session.thread_count(),
-              static_cast<unsigned long long>(st.dropped.total()), static_cast<unsigned long long>(d[0]),
-              static_cast<unsigned long long>(d[1]), static_cast<unsigned long long>(d[2]), o.out.c_str());
+  const std::string target = o.out_given ? o.out : film_out;
+  std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
+              static_cast<unsigned long long>(final_info.spp()), final_info.width, final_info.height, st.seconds,
+              st.samples_per_second * 1e-6, session.thread_count(), drops_text(final_info.dropped).c_str(),
+              target.c_str());
   if (reference.loaded()) {
     std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
                 "efficiency %.4g\n",
@@ -168,6 +370,61 @@ int run_render(const RenderOptions& o) {
       std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
                   "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
   }
+  return 0;
+}
+
+int run_merge(const MergeOptions& o) {
+  if (o.films.empty()) throw InputError("merge: name at least one film");
+  if (o.out.empty() && o.film_out.empty()) throw InputError("merge: nothing to write: give --out IMAGE, --film-out FILM or both");
+  if (!o.out.empty()) {
+    (void)image_format_for(o.out);
+    check_output_path(o.out);
+  }
+  if (!o.film_out.empty()) check_output_path(o.film_out);
+  if (!o.stats_json.empty()) check_output_path(o.stats_json);
+  check_distinct_outputs({o.out, o.film_out, o.stats_json});
+  const Transfer transfer = parse_transfer(o.transfer);
+
+  for (std::size_t i = 0; i < o.films.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(o.films[i], o.films[k], ec))
+        throw InputError("merge: film '" + o.films[i] + "' is named twice; its samples would be counted twice");
+    }
+
+  // Each film is checked against every one before it, so a refusal names the
+  // two files that disagree; then it is added and dropped.
+  FilmFile all = read_film_file(o.films.front());
+  std::vector<FilmInfo> seen{all.info};
+  for (std::size_t i = 1; i < o.films.size(); ++i) {
+    FilmFile next = read_film_file(o.films[i]);
+    for (std::size_t k = 0; k < i; ++k)
+      if (const std::string problem = merge_problem(o.films[k], seen[k], o.films[i], next.info); !problem.empty())
+        throw InputError(problem);
+    all.film.add_film(next.film);
+    all.info = merged_info(all.info, next.info);
+    seen.push_back(std::move(next.info));
+  }
+
+  if (!o.film_out.empty()) write_film_file(o.film_out, all.info, all.film);
+  if (!o.out.empty()) write_film_image(o.out, all.film, transfer, image_attributes(all.info));
+  if (!o.stats_json.empty()) {
+    nlohmann::json j;
+    j["films"] = o.films;
+    j["scene_file"] = all.info.scene_file;
+    j["strategy"] = all.info.strategy;
+    j["width"] = all.info.width;
+    j["height"] = all.info.height;
+    j["spp"] = all.info.spp();
+    j["samples"] = all.info.ranges_text();
+    j["seconds"] = all.info.seconds;
+    j["dropped"] = drops_json(all.info.dropped);
+    write_text(o.stats_json, j.dump(2) + "\n");
+  }
+  std::printf("merged %zu films: %llu spp (%s), %dx%d, %.2f s of rendering, %s -> %s\n", o.films.size(),
+              static_cast<unsigned long long>(all.info.spp()), all.info.ranges_text().c_str(), all.info.width,
+              all.info.height, all.info.seconds, drops_text(all.info.dropped).c_str(),
+              (!o.out.empty() ? o.out : o.film_out).c_str());
   return 0;
 }
 

@@ -21,13 +21,14 @@ struct Rendered {
 // Fails the test (and returns what there is) when the render takes longer than `timeout`.
 inline Rendered render_to_completion(std::shared_ptr<const Scene> scene, const std::string& strategy,
                                      std::uint32_t spp, std::uint64_t seed, int threads,
-                                     std::chrono::seconds timeout) {
+                                     std::chrono::seconds timeout, std::uint32_t first_sample = 0) {
   RenderSession session(threads);
   RenderSettings settings;
   settings.scene = std::move(scene);
   settings.strategy = Strategy::parse(strategy);
   settings.seed = seed;
   settings.target_spp = spp;
+  settings.first_sample = first_sample;
   session.set_settings(settings);
   EXPECT_TRUE(session.wait_until_done(timeout)) << "the render did not finish in " << timeout.count() << " s";
   return {session.copy_film(), session.stats()};

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <stdexcept>
 
 namespace pdflab {
 
@@ -39,6 +40,18 @@ void Film::clear() {
   std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
   std::fill(count_.begin(), count_.end(), 0u);
   std::fill(drop_mask_.begin(), drop_mask_.end(), std::uint8_t{0});
+}
+
+void Film::add_film(const Film& other) {
+  if (other.width_ != width_ || other.height_ != height_) throw std::invalid_argument("Film::add_film: sizes differ");
+  for (std::size_t i = 0; i < sum_.size(); ++i) {
+    sum_[i] += other.sum_[i];
+    sum_sq_[i] += other.sum_sq_[i];
+  }
+  for (std::size_t p = 0; p < count_.size(); ++p) {
+    count_[p] += other.count_[p];
+    drop_mask_[p] |= other.drop_mask_[p];
+  }
 }
 
 std::vector<float> Film::mean_rgb() const {

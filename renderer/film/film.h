@@ -86,6 +86,20 @@ class Film {
   std::uint8_t drop_mask(std::size_t pixel) const { return drop_mask_[pixel]; }
   const std::vector<std::uint8_t>& drop_masks() const { return drop_mask_; }
 
+  // The accumulation itself, for film files (film_file.h): 3 sums and 3 sums of
+  // squares per pixel (RGB), one count and one drop mask per pixel.
+  const std::vector<double>& sums() const { return sum_; }
+  const std::vector<double>& squares() const { return sum_sq_; }
+  const std::vector<std::uint32_t>& counts() const { return count_; }
+  std::vector<double>& sums() { return sum_; }
+  std::vector<double>& squares() { return sum_sq_; }
+  std::vector<std::uint32_t>& counts() { return count_; }
+  std::vector<std::uint8_t>& drop_masks() { return drop_mask_; }
+
+  // Adds another film of the same size pixel by pixel: sums, squares and counts
+  // add, drop masks combine. Throws std::invalid_argument on a size mismatch.
+  void add_film(const Film& other);
+
  private:
   int width_ = 0, height_ = 0;
   std::vector<double> sum_, sum_sq_;

@@ -1,9 +1,11 @@
 #include "renderer/film/image_io.h"
 
 #include "renderer/error.h"
+#include "renderer/film/exr_io.h"
 #include "renderer/film/film.h"
 
 #include <stb_image_write.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 namespace pdflab {
 
@@ -26,7 +29,8 @@ ImageFormat image_format_for(const std::string& path) {
   if (ext == ".png") return ImageFormat::Png;
   if (ext == ".pfm") return ImageFormat::Pfm;
   if (ext == ".hdr") return ImageFormat::Hdr;
-  throw InputError("output file '" + path + "': unknown image format '" + ext + "' (use .png, .pfm or .hdr)");
+  if (ext == ".exr") return ImageFormat::Exr;
+  throw InputError("output file '" + path + "': unknown image format '" + ext + "' (use .png, .pfm, .hdr or .exr)");
 }
 
 void check_output_path(const std::string& path) {
@@ -54,25 +58,65 @@ void check_distinct_outputs(const std::vector<std::string>& paths) {
   }
 }
 
-void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes) {
+AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   static std::atomic<unsigned> counter{0};
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
-  const bool wrote = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-  const int write_errno = errno;
-  const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
-  const int flush_errno = errno;
-  const bool closed = std::fclose(f) == 0;
-  if (!wrote || !flushed || !closed) {
-    std::remove(tmp.c_str());
-    throw IoError("cannot write '" + path + "': " + std::strerror(!wrote ? write_errno : flush_errno));
+  temp_ = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  file_ = std::fopen(temp_.c_str(), "wb");
+  if (!file_) throw IoError("cannot write '" + path_ + "': " + std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  if (file_) std::fclose(file_);
+  std::remove(temp_.c_str());
+}
+
+void AtomicFile::fail(int error) {
+  if (file_) std::fclose(file_);
+  file_ = nullptr;
+  std::remove(temp_.c_str());
+  committed_ = true;  // nothing left to clean up
+  throw IoError("cannot write '" + path_ + "': " + std::strerror(error));
+}
+
+void AtomicFile::write(const void* data, std::size_t size) {
+  if (!file_) throw std::logic_error("AtomicFile::write after release_to_writer");
+  if (std::fwrite(data, 1, size, file_) != size) fail(errno);
+}
+
+const std::string& AtomicFile::release_to_writer() {
+  if (file_ && std::fclose(file_) != 0) {
+    file_ = nullptr;
+    fail(errno);
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+  file_ = nullptr;
+  return temp_;
+}
+
+void AtomicFile::commit() {
+  if (committed_) throw std::logic_error("AtomicFile::commit twice");
+  if (file_) {
+    if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) fail(errno);
+    const bool closed = std::fclose(file_) == 0;
+    file_ = nullptr;
+    if (!closed) fail(errno);
+  } else {
+    // Written by another library: sync it through a descriptor of our own.
+    const int fd = ::open(temp_.c_str(), O_RDONLY);
+    if (fd < 0) fail(errno);
+    const bool synced = ::fsync(fd) == 0;
     const int e = errno;
-    std::remove(tmp.c_str());
-    throw IoError("cannot write '" + path + "': " + std::strerror(e));
+    ::close(fd);
+    if (!synced) fail(e);
   }
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0) fail(errno);
+  committed_ = true;
+}
+
+void write_file_atomic(const std::string& path, std::span<const std::uint8_t> bytes) {
+  AtomicFile file(path);
+  file.write(bytes.data(), bytes.size());
+  file.commit();
 }
 
 std::uint8_t tone_map_channel(float linear, Transfer transfer, float exposure) {
@@ -133,8 +177,43 @@ void write_image(const std::string& path, const std::vector<float>& rgb, int wid
     case ImageFormat::Png: bytes = encode_png(rgb, width, height, transfer); break;
     case ImageFormat::Pfm: bytes = encode_pfm(rgb, width, height); break;
     case ImageFormat::Hdr: bytes = encode_hdr(rgb, width, height); break;
+    case ImageFormat::Exr: write_exr(path, rgb, width, height); return;
   }
   write_file_atomic(path, bytes);
+}
+
+void write_film_image(const std::string& path, const Film& film, Transfer transfer,
+                      const std::vector<std::pair<std::string, std::string>>& attributes) {
+  const int w = film.width(), h = film.height();
+  switch (image_format_for(path)) {
+    case ImageFormat::Exr: write_exr(path, film, attributes); return;
+    case ImageFormat::Pfm: {
+      AtomicFile file(path);
+      const std::string header = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+      file.write(header.data(), header.size());
+      std::vector<float> row(3 * static_cast<std::size_t>(w));
+      for (int y = h - 1; y >= 0; --y) {  // PFM rows run bottom to top
+        const std::size_t first = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+        for (std::size_t x = 0; x < static_cast<std::size_t>(w); ++x) {
+          double m[3];
+          film.mean(first + x, m);
+          for (std::size_t c = 0; c < 3; ++c) row[3 * x + c] = static_cast<float>(m[c]);
+        }
+        file.write(row.data(), row.size() * sizeof(float));
+      }
+      file.commit();
+      return;
+    }
+    case ImageFormat::Png:
+    case ImageFormat::Hdr: write_image(path, film.mean_rgb(), w, h, transfer); return;
+  }
+}
+
+std::vector<float> read_image_linear(const std::string& path, int& width, int& height) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".exr") return read_exr(path, width, height);
+  return read_pfm(path, width, height);  // which says what else is wrong
 }
 
 std::vector<float> read_pfm(const std::string& path, int& width, int& height) {

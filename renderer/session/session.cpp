@@ -1,6 +1,7 @@
 #include "renderer/session/session.h"
 
 #include "renderer/integrator/packet.h"
+#include "renderer/error.h"
 #include "renderer/metrics/metrics.h"
 
 #include <algorithm>
@@ -35,7 +36,18 @@ RenderSession::~RenderSession() {
   for (auto& t : workers_) t.join();
 }
 
-void RenderSession::set_settings(RenderSettings settings) {
+void RenderSession::set_settings(RenderSettings settings) { change_settings(std::move(settings), std::nullopt); }
+
+void RenderSession::resume(RenderSettings settings, FilmStart start) {
+  if (settings.scene && (start.film.width() != settings.scene->camera.width ||
+                         start.film.height() != settings.scene->camera.height))
+    throw InputError("the film to continue is " + std::to_string(start.film.width()) + "x" +
+                     std::to_string(start.film.height()) + ", the camera " +
+                     std::to_string(settings.scene->camera.width) + "x" + std::to_string(settings.scene->camera.height));
+  change_settings(std::move(settings), std::move(start));
+}
+
+void RenderSession::change_settings(RenderSettings settings, std::optional<FilmStart> start) {
   if (!settings.scene) throw std::invalid_argument("RenderSession: settings without a scene");
   const SamplingPlan plan = SamplingPlan::make(settings.strategy, *settings.scene);  // may throw InputError
   // The film is resized by whichever thread applies the settings, possibly a
@@ -49,8 +61,9 @@ void RenderSession::set_settings(RenderSettings settings) {
       pending_ = true;
       pending_settings_ = std::move(settings);
       pending_plan_ = plan;
+      pending_start_ = std::move(start);
     } else {
-      apply_settings_locked(std::move(settings), plan);
+      apply_settings_locked(std::move(settings), plan, std::move(start));
       if (!paused_) start_pass_locked();
     }
   }
@@ -62,19 +75,25 @@ RenderSettings RenderSession::settings() const {
   return pending_ ? pending_settings_ : settings_;
 }
 
-void RenderSession::apply_settings_locked(RenderSettings settings, const SamplingPlan& plan) {
+void RenderSession::apply_settings_locked(RenderSettings settings, const SamplingPlan& plan,
+                                          std::optional<FilmStart> start) {
   settings_ = std::move(settings);
   plan_ = plan;
   plan_.scene = settings_.scene.get();
   const Camera& cam = settings_.scene->camera;
-  if (film_.width() != cam.width || film_.height() != cam.height) {
+  spp_done_ = 0;
+  drops_ = DropCounts{};
+  if (start) {
+    film_ = std::move(start->film);
+    spp_done_ = start->spp;
+    drops_ = start->dropped;
+  } else if (film_.width() != cam.width || film_.height() != cam.height) {
     film_.reset(cam.width, cam.height);
   } else {
     film_.clear();
   }
-  spp_done_ = 0;
   samples_done_ = 0;
-  drops_ = DropCounts{};
+  noise_ = NoiseSummary{};
   seconds_before_ = 0.0;
   running_clock_ = false;
   next_pass_spp_ = 1;
@@ -113,7 +132,7 @@ void RenderSession::start_pass_locked() {
     pass_.spp = 1;
     preview_.assign(3 * static_cast<std::size_t>(pass_.width) * static_cast<std::size_t>(pass_.height), 0.0f);
   } else {
-    pass_.first_sample = spp_done_;
+    pass_.first_sample = settings_.first_sample + spp_done_;
     pass_.spp = spp;
   }
   pass_.tiles_x = (pass_.width + kTile - 1) / kTile;
@@ -134,7 +153,8 @@ void RenderSession::finish_pass_locked() {
   const auto now = Clock::now();
   if (pending_) {
     pending_ = false;
-    apply_settings_locked(std::move(pending_settings_), pending_plan_);
+    apply_settings_locked(std::move(pending_settings_), pending_plan_, std::move(pending_start_));
+    pending_start_.reset();
     if (!paused_) start_pass_locked();
     done_cv_.notify_all();
     return;
@@ -160,9 +180,13 @@ void RenderSession::finish_pass_locked() {
   // One sweep over the film per pass for the image and its noise (a few ms at
   // 600x600 against passes of 30-120 ms), so a viewer shows noise without ever
   // touching the film.
-  noise_ = noise_summary(film_, spare_rse_, kRelMseEpsilon, &spare_rgb_);
-  spare_drops_ = film_.drop_masks();
-  publish_locked(spare_rgb_, pass_);
+  if (options_.publish_images) {
+    noise_ = noise_summary(film_, spare_rse_, kRelMseEpsilon, &spare_rgb_);
+    spare_drops_ = film_.drop_masks();
+    publish_locked(spare_rgb_, pass_);
+  } else {
+    noise_.estimated_relmse = estimated_relmse(film_);  // the same sweep without the image-sized buffers
+  }
 
   // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
   if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;
@@ -359,6 +383,7 @@ SessionStats RenderSession::stats() const {
   st.done = target != 0 && spp_done_ >= target && !pending_;
   if (target != 0) st.progress = std::min(1.0, (spp_done_ + pass_fraction * pass_.spp) / target);
   st.dropped = drops_;
+  st.estimated_relmse = noise_.estimated_relmse;
   return st;
 }
 
@@ -418,13 +443,24 @@ bool RenderSession::copy_published(PublishedImage& out, std::uint64_t& version) 
   return true;
 }
 
-Film RenderSession::copy_film() const {
-  std::unique_lock lk(mutex_);
+void RenderSession::wait_idle_locked(std::unique_lock<std::mutex>& lk, const char* caller) const {
   // The film is only consistent between passes: wait for the open one to end.
   const bool done = settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
-  if (!paused_ && !done) throw std::logic_error("RenderSession::copy_film while rendering");
+  if (!paused_ && !done) throw std::logic_error(std::string("RenderSession::") + caller + " while rendering");
   done_cv_.wait(lk, [&] { return !pass_open_; });
+}
+
+Film RenderSession::copy_film() const {
+  std::unique_lock lk(mutex_);
+  wait_idle_locked(lk, "copy_film");
   return film_;
+}
+
+void RenderSession::read_film(
+    const std::function<void(const Film&, std::uint32_t spp, const DropCounts&)>& read) const {
+  std::unique_lock lk(mutex_);
+  wait_idle_locked(lk, "read_film");
+  read(film_, spp_done_, drops_);
 }
 
 }  // namespace pdflab

@@ -17,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -27,6 +28,17 @@ struct RenderSettings {
   Strategy strategy = Strategy::single(Technique::Cosine);
   std::uint64_t seed = 1;
   std::uint32_t target_spp = 0;  // 0: render until stopped
+  // Sample index of the film's first sample: renders of disjoint index ranges
+  // of one seed (on several machines) merge into one render of their union.
+  std::uint32_t first_sample = 0;
+};
+
+// An accumulation to continue (a saved film): `spp` samples per pixel, indices
+// first_sample .. first_sample + spp - 1, with its drop counts.
+struct FilmStart {
+  Film film;
+  std::uint32_t spp = 0;
+  DropCounts dropped;
 };
 
 struct SessionStats {
@@ -37,6 +49,8 @@ struct SessionStats {
   double samples_per_second = 0.0;
   double progress = 0.0;           // 0..1 of target_spp (0 when unlimited)
   DropCounts dropped;
+  // The film's own relMSE estimate (metrics.h) after the last full pass; 0 before one.
+  double estimated_relmse = 0.0;
   bool done = false;               // target_spp reached
   bool paused = false;
 };
@@ -80,6 +94,10 @@ struct SessionOptions {
   // Called by a worker right after each new image is published (a viewer wakes
   // its event loop with it). Must be cheap and safe to call from any thread.
   std::function<void()> on_image;
+  // False for a headless render that reads the film at the end: no image,
+  // noise map or drop mask is published after each pass, so the session holds
+  // the film and nothing else of the image's size.
+  bool publish_images = true;
 };
 
 class RenderSession {
@@ -95,6 +113,10 @@ class RenderSession {
   // the strategy cannot be used on the scene or the image is too large
   // (check_image_size); the running render then goes on.
   void set_settings(RenderSettings settings);
+  // Like set_settings, but continues `start` instead of an empty film: its
+  // size must be the camera's (InputError otherwise). target_spp counts the
+  // samples already in it.
+  void resume(RenderSettings settings, FilmStart start);
   RenderSettings settings() const;
   void set_paused(bool paused);
   // Changes when rendering stops (0: never) without restarting the accumulation;
@@ -121,6 +143,9 @@ class RenderSession {
   // The full accumulation (sum, sum of squares, count). Only while paused or
   // done (waits for the pass in flight to end); throws std::logic_error otherwise.
   Film copy_film() const;
+  // Calls `read` with the film, its spp and drop counts, without copying the
+  // film; same conditions as copy_film. Rendering waits while `read` runs.
+  void read_film(const std::function<void(const Film&, std::uint32_t spp, const DropCounts&)>& read) const;
 
  private:
   struct Pass {
@@ -141,7 +166,9 @@ class RenderSession {
   void publish_locked(std::vector<float>& rgb, const Pass& pass);
   int preview_scale_locked() const;
   void finish_pass_locked();
-  void apply_settings_locked(RenderSettings settings, const SamplingPlan& plan);
+  void change_settings(RenderSettings settings, std::optional<FilmStart> start);
+  void apply_settings_locked(RenderSettings settings, const SamplingPlan& plan, std::optional<FilmStart> start);
+  void wait_idle_locked(std::unique_lock<std::mutex>& lk, const char* caller) const;
   void start_pass_locked();
   double elapsed_locked() const;
 
@@ -159,6 +186,7 @@ class RenderSession {
   bool pending_ = false;
   RenderSettings settings_, pending_settings_;
   SamplingPlan plan_, pending_plan_;
+  std::optional<FilmStart> pending_start_;
   Pass pass_;
   int inside_ = 0;  // workers working on the open pass
   std::uint32_t spp_done_ = 0;
