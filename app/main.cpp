@@ -80,7 +80,11 @@ int main(int argc, char** argv) {
   app.add_option("--ui-scale", view_ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
       ->check(CLI::Range(0.5f, 4.0f));
   app.add_flag("--presentation", view_presentation, "Start in presentation mode: full screen, no panel (F11 leaves)");
-  app.add_option("--reference", view_reference, "Reference image (PFM) for live error figures in the viewer");
+  app.add_option("--reference", view_reference,
+                 "Reference image (PFM) for live error figures in the viewer (default: the cached one, if any)");
+  double view_make_seconds = 0.0;
+  app.add_option("--reference-seconds", view_make_seconds, "Rendering time that Make reference starts with (30)")
+      ->check(positive_number(" of seconds"));
 
   pdflab::RenderOptions ro;
   CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
@@ -234,6 +238,7 @@ int main(int argc, char** argv) {
     vo.reference = view_reference;
     vo.ui_scale = view_ui_scale;
     vo.presentation = view_presentation;
+    vo.make_reference_seconds = view_make_seconds;
     return pdflab::run_viewer(vo);
 #else
     // Built without the viewer: render the default scene headlessly instead.

@@ -141,13 +141,13 @@ void TeachingViews::restart_split(const RenderSettings& main_settings) {
 }
 
 void TeachingViews::load_reference() {
-  reference_.clear();
-  reference_width_ = reference_height_ = 0;
+  own_reference_ = {};
   split_.reference_status.clear();
   if (split_.reference_path.empty()) return;
   try {
-    reference_ = read_pfm(split_.reference_path, reference_width_, reference_height_);
-    split_.reference_status = "loaded " + std::to_string(reference_width_) + "x" + std::to_string(reference_height_);
+    own_reference_ = pdflab::load_reference(split_.reference_path);
+    split_.reference_status =
+        "loaded " + std::to_string(own_reference_.width) + "x" + std::to_string(own_reference_.height);
   } catch (const std::exception& e) {
     split_.reference_status = e.what();
   }
@@ -162,8 +162,9 @@ void TeachingViews::pull(RenderSession& session, std::vector<float>& image, Imag
       f.noise = info.mean_relative_standard_error;
       f.estimated_relmse = info.estimated_relmse;
       f.reference_relmse = -1.0;
-      if (!reference_.empty() && reference_width_ == info.width && reference_height_ == info.height)
-        f.reference_relmse = relmse(image, reference_);
+      // Corrected for the reference's own noise, as the Measure section's figure.
+      if (const Reference* ref = reference(); ref && ref->width == info.width && ref->height == info.height)
+        f.reference_relmse = std::max(0.0, measure_relmse(image, ref->rgb, ref->variance).corrected);
     }
   }
   const SessionStats st = session.stats();
@@ -188,10 +189,19 @@ void TeachingViews::update(RenderSession& main, bool paused) {
   b_->set_paused(paused);
   pull(*a_, image_a_, info_a_, version_a_, stale_a_, split_.a);
   pull(*b_, image_b_, info_b_, version_b_, stale_b_, split_.b);
-  if (!reference_.empty() && split_.reference_status.rfind("loaded", 0) == 0 &&
-      (reference_width_ != ms.scene->camera.width || reference_height_ != ms.scene->camera.height))
-    split_.reference_status = "loaded, but " + std::to_string(reference_width_) + "x" +
-                              std::to_string(reference_height_) + " is not the render's size";
+  if (own_reference_.loaded() && split_.reference_status.rfind("loaded", 0) == 0 &&
+      (own_reference_.width != ms.scene->camera.width || own_reference_.height != ms.scene->camera.height))
+    split_.reference_status = "loaded, but " + std::to_string(own_reference_.width) + "x" +
+                              std::to_string(own_reference_.height) + " is not the render's size";
+  if (!own_reference_.loaded() && split_.reference_path.empty()) {
+    const Reference* shared = shared_reference_;
+    split_.reference_status =
+        !shared || !shared->loaded() ? std::string()
+        : shared->width == ms.scene->camera.width && shared->height == ms.scene->camera.height
+            ? "using the Measure section's reference (" + std::to_string(shared->width) + "x" +
+                  std::to_string(shared->height) + ")"
+            : "the Measure section's reference is not the render's size";
+  }
   follow_probe(main);
 }
 

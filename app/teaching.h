@@ -2,6 +2,7 @@
 // The teaching views in the viewer: split screen A/B, the pixel probe and the
 // 1D lab. The viewer calls these few hooks; everything else about the views
 // lives here and in ui/split_view, ui/probe_panel, ui/lab1d_panel.
+#include "renderer/metrics/reference.h"
 #include "renderer/session/session.h"
 #include "ui/display.h"
 #include "ui/lab1d_panel.h"
@@ -35,6 +36,9 @@ class TeachingViews {
   void draw_ui(RenderSession& main, const ui::Viewport& image, int framebuffer_height, float framebuffer_scale,
                float area_width, float area_height);
   bool split_active() const { return split_.on; }
+  // The Measure section's reference (or null): both sides are measured against
+  // it unless the split's own reference field names another.
+  void set_shared_reference(const Reference* reference) { shared_reference_ = reference; }
   // A left click on the image means something here (a probe, the divider): it does not pan.
   bool takes_left_clicks() const { return probe_.mode || split_.on; }
   // The split's state for the side panel; null while it is off.
@@ -79,8 +83,9 @@ class TeachingViews {
   std::uint64_t version_a_ = 0, version_b_ = 0;
   bool stale_a_ = false, stale_b_ = false, new_image_ = false;
   std::unique_ptr<ui::ImageDisplay> display_a_, display_b_;
-  std::vector<float> reference_;
-  int reference_width_ = 0, reference_height_ = 0;
+  Reference own_reference_;                      // the split's own field
+  const Reference* shared_reference_ = nullptr;  // the Measure section's
+  const Reference* reference() const { return own_reference_.loaded() ? &own_reference_ : shared_reference_; }
 };
 
 }  // namespace pdflab

@@ -2,6 +2,7 @@
 
 #include "app/assets.h"
 #include "app/teaching.h"
+#include "app/viewer_references.h"
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
@@ -91,6 +92,8 @@ struct Viewer::Impl {
   ui::MeasureState measure;
   std::unique_ptr<RenderSession> session;
   std::unique_ptr<TeachingViews> teaching;
+  std::unique_ptr<ViewerReferences> references;
+  bool main_rests_for_reference = false;  // paused while a reference takes every thread
 
   std::shared_ptr<const Scene> base_scene;  // as loaded
   std::string scene_path;
@@ -177,6 +180,8 @@ struct Viewer::Impl {
   }
   void fill_status();
   void load_reference(const std::string& path);
+  void after_reference_changed();
+  void service_references();
   void handle_measure_requests(const ui::MeasureRequests& r);
 };
 
@@ -200,6 +205,7 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   if (!(o.ui_scale >= ui::kMinUiScale && o.ui_scale <= ui::kMaxUiScale))
     throw InputError("--ui-scale " + std::to_string(o.ui_scale) + " is outside 0.5..4");
   settings.ui_scale = o.ui_scale;
+  if (o.make_reference_seconds > 0.0) settings.measure.make_seconds = static_cast<float>(o.make_reference_seconds);
   if (!o.reference.empty()) {
     measure.set_reference(ui::load_reference(o.reference));  // a bad file is bad input, before any window
     settings.measure.reference_field = o.reference;
@@ -217,6 +223,8 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   so.on_image = [] { glfwPostEmptyEvent(); };
   session = std::make_unique<RenderSession>(so);
   teaching = std::make_unique<TeachingViews>(so.on_image);
+  teaching->set_shared_reference(&measure.reference);
+  references = std::make_unique<ViewerReferences>();
   if (!apply_render_settings()) throw InputError(status.settings_error);
   if (o.presentation && !cli_mode()) set_presentation(true);
 }
@@ -343,6 +351,7 @@ void Viewer::Impl::rebuild_fonts() {
 
 void Viewer::Impl::close() {
   teaching.reset();
+  references.reset();  // a reference in the making stops with the viewer
   session.reset();  // workers stop first: nothing renders into a closing viewer
   if (save_job.valid()) save_job.wait();
   display.reset();
@@ -388,6 +397,12 @@ bool Viewer::Impl::apply_render_settings() {
     render_scene_scale = settings.resolution_scale;
     render_scene_override = overridden;
   }
+  // Never the reference's random numbers: a seed it was rendered with is changed.
+  std::string seed_note;
+  if (const auto other = decorrelated_seed(measure.reference, settings.seed, strategy, seed_note)) {
+    settings.seed = *other;
+    measure.reference_note = seed_note;
+  }
   RenderSettings rs;
   rs.scene = render_scene;
   rs.strategy = strategy;
@@ -401,7 +416,23 @@ bool Viewer::Impl::apply_render_settings() {
   }
   status.settings_error.clear();
   applied = settings;
+  if (references && references->follow_scene(*render_scene, measure)) after_reference_changed();
   return true;
+}
+
+void Viewer::Impl::after_reference_changed() {
+  std::string note;
+  if (decorrelated_seed(measure.reference, applied.seed, applied.sampling.strategy(), note)) apply_render_settings();
+}
+
+void Viewer::Impl::service_references() {
+  if (references->service(measure)) after_reference_changed();
+  // At 100% of the threads the main render rests until the reference is done.
+  const bool rest = references->wants_main_paused();
+  if (rest != main_rests_for_reference) {
+    main_rests_for_reference = rest;
+    session->set_paused(rest || settings.paused);
+  }
 }
 
 void Viewer::Impl::load_scene(const std::string& path) {
@@ -521,6 +552,10 @@ void Viewer::Impl::on_key(int key, int mods) {
       break;
     case GLFW_KEY_V: settings.measure.view_mode = ui::next_view_mode(settings.measure.view_mode); break;
     case GLFW_KEY_G: settings.measure.show_plot = !settings.measure.show_plot; break;
+    case GLFW_KEY_M:  // make a reference, as the Measure section's button; again: cancel
+      if (references->running()) references->cancel(measure);
+      else if (render_scene) references->start(*render_scene, scene_path, settings.measure, measure);
+      break;
     case GLFW_KEY_K: measure.curves.pin(); break;  // keep
     case GLFW_KEY_H:
     case GLFW_KEY_F1: panel.show_help = !panel.show_help; break;
@@ -702,14 +737,24 @@ void Viewer::Impl::fill_status() {
 void Viewer::Impl::load_reference(const std::string& path) {
   try {
     measure.set_reference(ui::load_reference(path));
+    measure.reference_from_cache = false;
+    measure.reference_note.clear();
   } catch (const std::exception& e) {
     measure.reference_error = e.what();  // the previous reference stays
+    return;
   }
+  after_reference_changed();
 }
 
 void Viewer::Impl::handle_measure_requests(const ui::MeasureRequests& r) {
   if (!r.load_reference.empty()) load_reference(r.load_reference);
-  if (r.clear_reference) measure.set_reference({});
+  if (r.clear_reference) {
+    measure.set_reference({});
+    measure.reference_from_cache = false;
+    measure.reference_note.clear();
+  }
+  if (r.make_reference && render_scene) references->start(*render_scene, scene_path, settings.measure, measure);
+  if (r.cancel_reference) references->cancel(measure);
   if (r.render_at_reference_size && measure.reference.loaded()) {
     settings.width_override = measure.reference.width;
     settings.height_override = measure.reference.height;
@@ -741,6 +786,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   for (const Impl::KeyPress& k : v.keys) v.on_key(k.key, k.mods);
   v.keys.clear();
   v.pull_image();
+  v.service_references();
   v.teaching->update(*v.session, v.settings.paused);
   v.service_screenshots();
 
@@ -873,7 +919,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   if (paced) {
     // Events wake the wait early, so input is never delayed by the pacing.
     const SessionStats& st = v.status.stats;
-    const bool busy = !(st.done || st.paused) || v.save_job.valid() || v.screenshot_wanted ||
+    const bool busy = !(st.done || st.paused) || v.save_job.valid() || v.screenshot_wanted || v.references->running() ||
                       ImGui::IsAnyItemActive() || v.status.now - v.status.notice.shown_at < 0.5 ||
                       v.teaching->wants_frames();
     const double period = busy ? kFramePeriod : kIdlePeriod;

@@ -19,6 +19,7 @@ struct ViewerOptions {
   std::string reference;  // PFM to measure the error against (empty: none)
   float ui_scale = 1.0f;  // panels and text, times the screen's own scale (0.5..4)
   bool presentation = false;  // start full screen without the panel
+  double make_reference_seconds = 0.0;  // the Make reference time's first value (0: 30 s)
 };
 
 // Runs the viewer until the window closes. Returns the process exit status;

@@ -29,12 +29,6 @@ ViewMode next_view_mode(ViewMode mode) {
   return static_cast<ViewMode>((static_cast<int>(mode) + 1) % kViewModeCount);
 }
 
-ReferenceImage load_reference(const std::string& path) {
-  ReferenceImage ref;
-  ref.rgb = read_pfm(path, ref.width, ref.height);  // throws InputError with the path
-  ref.path = path;
-  return ref;
-}
 
 std::string reference_size_mismatch(const ReferenceImage& reference, int render_width, int render_height) {
   if (!reference.loaded() || (reference.width == render_width && reference.height == render_height)) return {};
@@ -46,23 +40,31 @@ std::string reference_size_mismatch(const ReferenceImage& reference, int render_
 
 double Figures::plot_error() const {
   if (!valid) return 0.0;
-  return std::sqrt(against_reference ? relmse : estimated_relmse);
+  return std::sqrt(std::max(0.0, against_reference ? relmse : estimated_relmse));
 }
 
-Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, const ReferenceImage* reference) {
+Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, const ReferenceImage* reference,
+                        bool unbiased) {
   Figures f;
   if (info.preview || info.spp == 0) return f;
   f.valid = true;
   f.spp = info.spp;
   f.seconds = info.seconds;
+  f.unbiased = unbiased;
   f.mean_relative_standard_error = info.mean_relative_standard_error;
   f.estimated_relmse = info.estimated_relmse;
-  f.estimated_efficiency = efficiency(f.estimated_relmse, f.seconds);
+  f.estimated_efficiency = unbiased ? efficiency(f.estimated_relmse, f.seconds) : 0.0;
   if (reference && reference->loaded() && reference->width == info.width && reference->height == info.height &&
       reference->rgb.size() == rgb.size()) {
     f.against_reference = true;
     f.rmse = rmse(rgb, reference->rgb);
-    f.relmse = relmse(rgb, reference->rgb, kRelMseEpsilon);
+    const RelMseMeasure m = measure_relmse(rgb, reference->rgb, reference->has_variance() ? reference->variance
+                                                                                          : std::vector<float>{});
+    f.relmse = m.corrected;
+    f.relmse_interval = m.interval;
+    f.relmse_raw = m.raw;
+    f.reference_share = m.reference_share();
+    f.reference_corrected = m.reference_corrected;
     f.efficiency = efficiency(f.relmse, f.seconds);
   }
   return f;
@@ -311,8 +313,29 @@ bool build_view_layer(ViewMode mode, const PublishedImage& image, const Referenc
   return false;
 }
 
+namespace {
+
+bool label_unbiased(const std::string& label) {
+  try {
+    return Strategy::parse(label).is_unbiased();
+  } catch (const std::exception&) {
+    return true;  // not a strategy (a test's label): nothing is withheld
+  }
+}
+
+}  // namespace
+
 void MeasureState::on_image(std::uint64_t current_generation, const std::string& label) {
-  figures = compute_figures(published.info, published.rgb, &reference);
+  const bool unbiased = label_unbiased(label);
+  if (!published.info.preview && published.info.spp > 0) {
+    if (published.info.generation != history_generation) {
+      history.clear();
+      history_generation = published.info.generation;
+    }
+    history.add(published.info.spp, published.info.estimated_relmse);
+  }
+  figures = compute_figures(published.info, published.rgb, &reference, unbiased);
+  figures.estimate_unreliable = history.unreliable();
   if (figures.valid && published.info.generation == current_generation)
     curves.record(published.info.generation, label, !figures.against_reference, figures.spp, figures.seconds,
                   figures.plot_error());
@@ -323,7 +346,9 @@ void MeasureState::on_image(std::uint64_t current_generation, const std::string&
 void MeasureState::set_reference(ReferenceImage image) {
   reference = std::move(image);
   reference_error.clear();
-  figures = compute_figures(published.info, published.rgb, &reference);
+  const bool unbiased = figures.unbiased;
+  figures = compute_figures(published.info, published.rgb, &reference, unbiased);
+  figures.estimate_unreliable = history.unreliable();
   layer_ok = false;
   layer_why.clear();
 }

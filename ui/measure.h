@@ -3,6 +3,8 @@
 // the reference image, error figures of each published pass, convergence
 // curves, colour maps and their legends. No ImGui and no OpenGL here, so every
 // number the panels show can be unit-tested.
+#include "renderer/metrics/metrics.h"
+#include "renderer/metrics/reference.h"
 #include "renderer/session/session.h"
 
 #include <array>
@@ -23,6 +25,12 @@ struct MeasureSettings {
   bool show_plot = false;  // G shows it; off at first so the image is seen whole
   bool plot_against_spp = false;  // false: against rendering seconds
   std::string reference_field;    // the path as typed
+  // "Make reference": its size as a divisor of the render's (1, 2 or 4), its
+  // rendering time, and the share of the hardware threads it takes (at 1 the
+  // main render pauses until it is done).
+  int make_divisor = 1;
+  float make_seconds = 30.0f;
+  float make_thread_share = 0.5f;
 };
 
 // What the measuring panels ask for this frame.
@@ -30,19 +38,18 @@ struct MeasureRequests {
   std::string load_reference;  // non-empty: try this PFM
   bool clear_reference = false;
   bool render_at_reference_size = false;
+  bool make_reference = false;
+  bool cancel_reference = false;
   bool pin_curve = false;
   bool clear_pins = false;
 };
 
-struct ReferenceImage {
-  std::string path;
-  std::vector<float> rgb;  // linear RGB, row 0 at the top
-  int width = 0, height = 0;
-  bool loaded() const { return width > 0 && height > 0; }
-};
+// The reference (renderer/metrics/reference.h): mean, variance, sidecar.
+using ReferenceImage = pdflab::Reference;
 
-// Reads a PFM. Throws InputError naming the file when it cannot.
-ReferenceImage load_reference(const std::string& path);
+// Reads a reference (a PFM, with its variance and sidecar when they are
+// there). Throws InputError naming the file when it cannot.
+using pdflab::load_reference;
 // Empty when the sizes agree; otherwise a sentence saying which is which.
 std::string reference_size_mismatch(const ReferenceImage& reference, int render_width, int render_height);
 
@@ -52,10 +59,20 @@ struct Figures {
   bool against_reference = false;  // rmse, relmse, efficiency measured; else only estimates
   std::uint32_t spp = 0;
   double seconds = 0.0;
+  // relmse is corrected for the reference's noise (metrics.h, measure_relmse):
+  // relmse_interval its 95% half width, relmse_raw the uncorrected figure.
   double rmse = 0.0, relmse = 0.0, efficiency = 0.0;
-  // The film's own account (metrics.h), available without a reference.
+  double relmse_interval = 0.0, relmse_raw = 0.0, reference_share = 0.0;
+  bool reference_corrected = false;  // false: the reference has no variance
+  // The film's own account (metrics.h), available without a reference: a
+  // lower bound on the error (blind to what the samples never found).
   double mean_relative_standard_error = 0.0;
   double estimated_relmse = 0.0, estimated_efficiency = 0.0;
+  // A biased strategy gets no efficiency from the estimate (0 then): it would
+  // rank a strategy that misses light as the best.
+  bool unbiased = true;
+  // The estimate stopped falling as samples doubled (EstimateHistory).
+  bool estimate_unreliable = false;
   // What the convergence plot draws: the relative RMS error sqrt(relMSE),
   // measured when there is a reference of the right size, estimated otherwise.
   // It falls as 1/sqrt(N) for an unbiased strategy, like the noise.
@@ -63,7 +80,9 @@ struct Figures {
 };
 
 // `reference` may be null or of another size: then only the estimates are set.
-Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, const ReferenceImage* reference);
+// `unbiased`: of the strategy that rendered the image.
+Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, const ReferenceImage* reference,
+                        bool unbiased = true);
 
 struct CurvePoint {
   double spp = 0.0, seconds = 0.0, error = 0.0;
@@ -161,10 +180,24 @@ struct ViewLayer {
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
                       std::string& why);
 
+// A "Make reference" in progress, as the panel shows it.
+struct ReferenceBuildStatus {
+  bool running = false;
+  bool finishing = false;  // rendered; being stored
+  int width = 0, height = 0, threads = 0;
+  double fraction = 0.0, seconds_left = 0.0;
+  std::uint32_t spp = 0;
+};
+
 // Everything measured so far, owned by the viewer and read by the panels.
 struct MeasureState {
   ReferenceImage reference;
+  bool reference_from_cache = false;  // found in the cache (or made here), not loaded by hand
   std::string reference_error;  // the last failed load, empty when fine
+  std::string reference_note;   // how the reference came (cache, made), or a seed changed for it
+  ReferenceBuildStatus build;
+  EstimateHistory history;      // of the generation on screen
+  std::uint64_t history_generation = ~std::uint64_t{0};
   Figures figures;              // of the image on screen
   ConvergenceRecorder curves;
   PublishedImage published;     // the image on screen with its noise map and drop mask

@@ -41,6 +41,64 @@ void figure_row(const char* label, const char* tooltip, const char* fmt, double 
   ImGui::Text(fmt, value);
 }
 
+void text_row(const char* label, const char* tooltip, const std::string& value, const ImVec4* colour = nullptr) {
+  ImGui::TableNextColumn();
+  ImGui::TextColored(kDim, "%s", label);
+  if (tooltip && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tooltip);
+  ImGui::TableNextColumn();
+  if (colour) ImGui::TextColored(*colour, "%s", value.c_str());
+  else ImGui::TextUnformatted(value.c_str());
+}
+
+std::string printed(const char* fmt, double a, double b = 0.0) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, a, b);
+  return buf;
+}
+
+// "Make reference": the button and its settings, or the running build's progress.
+void make_reference_controls(MeasureSettings& ms, const MeasureState& m, const UiStatus& status,
+                             UiRequests& requests) {
+  const ReferenceBuildStatus& b = m.build;
+  if (b.running) {
+    char overlay[96];
+    if (b.finishing) std::snprintf(overlay, sizeof overlay, "storing...");
+    else std::snprintf(overlay, sizeof overlay, "%d%%  ~%.0f s left  %u spp", static_cast<int>(b.fraction * 100.0),
+                       b.seconds_left, b.spp);
+    ImGui::ProgressBar(static_cast<float>(b.fraction), ImVec2(-1.0f, 0.0f), overlay);
+    ImGui::TextColored(kDim, "Making a reference: %dx%d on %d threads", b.width, b.height, b.threads);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Cancel##reference")) requests.measure.cancel_reference = true;
+    return;
+  }
+  if (ImGui::Button("Make reference")) requests.measure.make_reference = true;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Renders a reference in the background (unbiased, seeds no render uses) and stores it in\n"
+                      "the reference cache; then every figure is measured against it.");
+  ImGui::SameLine();
+  const int w = status.width, h = status.height;
+  char sizes[3][48];
+  for (int i = 0; i < 3; ++i)
+    std::snprintf(sizes[i], sizeof sizes[i], "%dx%d%s", std::max(1, w >> i), std::max(1, h >> i),
+                  i == 0 ? " (this size)" : "");
+  int choice = ms.make_divisor >= 4 ? 2 : (ms.make_divisor >= 2 ? 1 : 0);
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
+  if (ImGui::BeginCombo("##make size", sizes[choice])) {
+    for (int i = 0; i < 3; ++i)
+      if (ImGui::Selectable(sizes[i], choice == i)) choice = i;
+    ImGui::EndCombo();
+  }
+  ms.make_divisor = 1 << choice;
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+  ImGui::SliderFloat("##make seconds", &ms.make_seconds, 5.0f, 600.0f, "%.0f s", ImGuiSliderFlags_Logarithmic);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
+  float percent = ms.make_thread_share * 100.0f;
+  ImGui::SliderFloat("##make threads", &percent, 10.0f, 100.0f, "%.0f%% of threads");
+  ms.make_thread_share = std::clamp(percent / 100.0f, 0.1f, 1.0f);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("At 100%% the main render pauses until the reference is done.");
+}
+
 void draw_colour_bar(const ColourScale& scale, float width) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const float bar_h = ImGui::GetFontSize() * 0.9f;
@@ -270,21 +328,31 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
   if ((ImGui::Button("Load##reference") || entered) && !ms.reference_field.empty())
     requests.measure.load_reference = ms.reference_field;
   if (m->reference.loaded()) {
+    const ReferenceInfo& ri = m->reference.info;
     ImGui::TextColored(kDim, "reference: %s, %dx%d",
-                       std::filesystem::path(m->reference.path).filename().string().c_str(), m->reference.width,
-                       m->reference.height);
+                       m->reference_from_cache ? "from the cache"
+                                               : std::filesystem::path(m->reference.path).filename().string().c_str(),
+                       m->reference.width, m->reference.height);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", m->reference.path.c_str());
     ImGui::SameLine();
     if (ImGui::SmallButton("Drop")) requests.measure.clear_reference = true;
+    if (ri.spp > 0 || !ri.strategy.empty())
+      ImGui::TextColored(kDim, "  %u spp, %s%s", ri.spp, ri.strategy.empty() ? "?" : ri.strategy.c_str(),
+                         m->reference.has_variance() ? "" : ", no variance: its noise is not removed");
   } else {
-    ImGui::TextColored(kDim, "No reference: errors below are estimates.");
-    if (ImGui::IsItemHovered())
-      ImGui::SetTooltip("Make one with e.g.\npdflab render --scene S --strategy nee-mis --spp 4096 --out ref.pfm");
+    ImGui::TextColored(kDim, "No reference: errors below are estimates (lower bounds).");
+  }
+  if (!m->reference_note.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kGreen);
+    ImGui::TextWrapped("%s", m->reference_note.c_str());
+    ImGui::PopStyleColor();
   }
   if (!m->reference_error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kRed);
     ImGui::TextWrapped("%s", m->reference_error.c_str());
     ImGui::PopStyleColor();
   }
+  make_reference_controls(ms, *m, status, requests);
   const std::string mismatch = m->size_mismatch(status.width, status.height);
   if (!mismatch.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kAmber);
@@ -298,22 +366,52 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
   const Figures& f = m->figures;
   if (!f.valid) {
     ImGui::TextColored(kDim, "Figures appear after the first full pass.");
-  } else if (ImGui::BeginTable("figures", 2, ImGuiTableFlags_SizingStretchProp)) {
-    if (f.against_reference) {
-      figure_row("RMSE", "root mean squared error against the reference, all pixels and channels", "%.5g", f.rmse);
-      figure_row("relMSE (eps 1e-2)", "mean of (x - r)^2 / (r^2 + 0.01) over pixels and channels", "%.5g", f.relmse);
-      figure_row("efficiency", "1 / (relMSE * seconds): higher is better, flat over time when unbiased", "%.5g",
-                 f.efficiency);
+  } else {
+    ImGui::TextColored(f.against_reference ? kGreen : kAmber, f.against_reference
+                                                                  ? "MEASURED against the reference"
+                                                                  : "ESTIMATED from the film's own variance");
+    if (ImGui::BeginTable("figures", 2, ImGuiTableFlags_SizingStretchProp)) {
+      if (f.against_reference) {
+        figure_row("RMSE", "root mean squared error against the reference, all pixels and channels", "%.5g", f.rmse);
+        text_row("relMSE (eps 1e-2)",
+                 "mean of ((x - r)^2 - var(r)) / (r^2 + 0.01): the error against the true image, the reference's own\n"
+                 "noise removed, with its 95% interval (docs/measuring.md)",
+                 printed("%.4g +- %.2g", f.relmse, f.relmse_interval));
+        text_row("relMSE raw", "mean of (x - r)^2 / (r^2 + 0.01), the reference's noise included",
+                 printed("%.4g", f.relmse_raw));
+        const ImVec4 share_colour = f.reference_share > 0.2 ? kAmber : kDim;
+        text_row("reference's share", "the reference's own noise as a part of the raw relMSE",
+                 f.reference_corrected ? printed("%.1f%%", 100.0 * f.reference_share) : std::string("unknown"),
+                 &share_colour);
+        if (f.relmse > 0.0)
+          figure_row("efficiency", "1 / (relMSE * seconds): higher is better, flat over time when unbiased", "%.5g",
+                     f.efficiency);
+        else
+          text_row("efficiency", "relMSE is within the reference's noise of 0", "beyond the reference's precision");
+      }
+      figure_row("mean rel. std. error",
+                 "the film's own noise: sqrt(variance of the mean) / mean, averaged over pixels", "%.5g",
+                 f.mean_relative_standard_error);
+      figure_row(f.against_reference ? "relMSE, estimated" : "relMSE ESTIMATE (lower bound)",
+                 "variance of the mean / (mean^2 + 0.01): the expected relMSE of an unbiased strategy, at best.\n"
+                 "Blind to what the samples never found (a biased strategy looks good here).",
+                 "%.5g", f.estimated_relmse);
+      if (f.unbiased)
+        figure_row(f.against_reference ? "efficiency, estimated" : "efficiency ESTIMATE",
+                   "1 / (estimated relMSE * seconds)", "%.5g", f.estimated_efficiency);
+      else if (!f.against_reference)
+        text_row("efficiency", nullptr, "none: biased strategy", &kRed);
+      ImGui::EndTable();
     }
-    figure_row("mean rel. std. error", "the film's own noise: sqrt(variance of the mean) / mean, averaged over pixels",
-               "%.5g", f.mean_relative_standard_error);
-    figure_row(f.against_reference ? "relMSE, estimated" : "relMSE ESTIMATE (eps 1e-2)",
-               "variance of the mean / (mean^2 + 0.01): the expected relMSE of an unbiased strategy.\nBlind to what "
-               "the samples never found (a biased strategy looks good here).",
-               "%.5g", f.estimated_relmse);
-    figure_row(f.against_reference ? "efficiency, estimated" : "efficiency ESTIMATE",
-               "1 / (estimated relMSE * seconds)", "%.5g", f.estimated_efficiency);
-    ImGui::EndTable();
+    if (!f.unbiased && !f.against_reference)
+      ImGui::TextWrapped("No efficiency without a reference: this strategy never samples indirect light, so its own "
+                         "variance hides the light it misses and would rank it best.");
+    if (f.estimate_unreliable && !f.against_reference) {
+      ImGui::PushStyleColor(ImGuiCol_Text, kAmber);
+      ImGui::TextWrapped("The estimate is unreliable: it did not fall as the samples doubled (rare bright paths are "
+                         "still being found). Make a reference to measure.");
+      ImGui::PopStyleColor();
+    }
     ImGui::TextColored(kDim, "at %u spp, %.2f s of rendering", f.spp, f.seconds);
   }
   ImGui::Checkbox("Convergence plot (G)", &ms.show_plot);

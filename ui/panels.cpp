@@ -379,6 +379,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"V", "next view: image, noise heat map, difference, drops"},
         {"G", "show / hide the convergence plot (graph)"},
         {"K", "keep (pin) the running convergence curve"},
+        {"M", "make a reference (Measure section; M again cancels)"},
         {"F12", "screenshot: PNG + PFM + JSON"},
         {"S", "split screen A/B: two strategies, equal time"},
         {"P", "pixel probe: click a pixel (C: chi-square)"},

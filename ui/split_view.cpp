@@ -33,8 +33,11 @@ void side_box(const char* id, const char* side, const SideFigures& f, ImVec2 pos
     ImGui::Text("noise (rel. std. error)  %s", format_figure(f.noise, true).c_str());
     if (f.reference_relmse >= 0.0) ImGui::Text("relMSE vs reference  %s", format_figure(f.reference_relmse).c_str());
     else ImGui::TextColored(kDim, "relMSE (film estimate)  %s", format_figure(f.estimated_relmse).c_str());
-    ImGui::Text("efficiency 1/(relMSE t)  %s%s", format_figure(f.efficiency()).c_str(),
-                f.efficiency_from_reference() ? "" : " (est.)");
+    if (!f.unbiased && !f.efficiency_from_reference())
+      ImGui::TextColored(kDim, "efficiency: none (biased, no reference)");
+    else
+      ImGui::Text("efficiency 1/(relMSE t)  %s%s", format_figure(f.efficiency()).c_str(),
+                  f.efficiency_from_reference() ? "" : " (est.)");
   }
   ImGui::End();
 }
@@ -59,6 +62,8 @@ bool SplitDivider::update(float mouse_x, float mouse_y, bool clicked, bool down,
 }
 
 double SideFigures::efficiency() const {
+  // Without a reference a biased strategy's own estimate hides what it misses: no figure.
+  if (reference_relmse < 0.0 && !unbiased) return -1.0;
   const double relmse = reference_relmse >= 0.0 ? reference_relmse : estimated_relmse;
   if (!(relmse > 0.0) || !(seconds > 0.0)) return -1.0;
   return pdflab::efficiency(relmse, seconds);
@@ -142,7 +147,7 @@ void draw_split_controls(SplitState& s, SplitRequests& requests, float area_widt
     requests.load_reference = true;
   if (!s.reference_status.empty()) {
     ImGui::SameLine();
-    const bool ok = s.reference_status.rfind("loaded", 0) == 0;
+    const bool ok = s.reference_status.rfind("loaded", 0) == 0 || s.reference_status.rfind("using", 0) == 0;
     ImGui::TextColored(ok ? kGreen : kRed, "%s", s.reference_status.c_str());
   }
   ImGui::End();

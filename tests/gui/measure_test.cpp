@@ -80,8 +80,11 @@ TEST(Convergence, PinKeepsTheCurveUnderItsLabel) {
   EXPECT_EQ(rec.live().label, "mix:cosine=0.5,light=0.5");  // the next strategy runs against it
 
   for (std::size_t i = 0; i < ConvergenceRecorder::kMaxPins + 2; ++i) {
-    rec.record(10 + i, "s" + std::to_string(i), false, 1, 0.1, 0.5);
-    rec.record(10 + i, "s" + std::to_string(i), false, 2, 0.2, 0.4);
+    // Appended, not "s" + to_string: GCC 12 warns falsely (-Wrestrict) on that once inlined here.
+    std::string label = "s";
+    label += std::to_string(i);
+    rec.record(10 + i, label, false, 1, 0.1, 0.5);
+    rec.record(10 + i, label, false, 2, 0.2, 0.4);
     rec.pin();
   }
   EXPECT_EQ(rec.pins().size(), ConvergenceRecorder::kMaxPins);
@@ -171,6 +174,42 @@ TEST(ColourMaps, DifferenceLegendIsSymmetricAndNice) {
   ASSERT_EQ(diff.size(), 2u);
   EXPECT_NEAR(diff[0], 0.5f, 1e-6f);
   EXPECT_NEAR(diff[1], -0.0722f, 1e-6f);
+}
+
+TEST(Reference, FiguresAreCorrectedForTheReferencesNoise) {
+  ReferenceImage ref;
+  ref.width = 4;
+  ref.height = 2;
+  ref.rgb.assign(24, 0.5f);
+  PublishedImage img = flat_image(4, 2, 0.6f);
+  const double raw = 0.01 / (0.25 + 0.01);
+  ref.variance.assign(24, 0.002f);  // its own noise: 0.002 / 0.26 of relMSE
+  const Figures f = compute_figures(img.info, img.rgb, &ref);
+  ASSERT_TRUE(f.against_reference);
+  EXPECT_TRUE(f.reference_corrected);
+  EXPECT_NEAR(f.relmse_raw, raw, 1e-6);
+  EXPECT_NEAR(f.relmse, (0.01 - 0.002) / 0.26, 1e-6);
+  EXPECT_NEAR(f.reference_share, 0.2, 1e-5);
+  EXPECT_NEAR(f.efficiency, 1.0 / (f.relmse * 2.0), 1e-9);
+}
+
+TEST(Reference, BiasedStrategyWithoutReferenceHasNoEfficiency) {
+  const PublishedImage img = flat_image(4, 2, 0.6f);
+  ASSERT_GT(img.info.estimated_relmse, 0.0);
+  const Figures biased = compute_figures(img.info, img.rgb, nullptr, false);
+  ASSERT_TRUE(biased.valid);
+  EXPECT_FALSE(biased.unbiased);
+  EXPECT_EQ(biased.estimated_efficiency, 0.0) << "no figure that would crown a strategy missing light";
+  const Figures unbiased = compute_figures(img.info, img.rgb, nullptr, true);
+  EXPECT_GT(unbiased.estimated_efficiency, 0.0);
+  // The state takes it from the strategy's name.
+  MeasureState m;
+  m.published = img;
+  m.on_image(img.info.generation, "light");
+  EXPECT_FALSE(m.figures.unbiased);
+  EXPECT_EQ(m.figures.estimated_efficiency, 0.0);
+  m.on_image(img.info.generation, "mix:cosine=0.5,light=0.5");
+  EXPECT_GT(m.figures.estimated_efficiency, 0.0);
 }
 
 TEST(Reference, SizeMismatchIsSaidAndFiguresFallBackToEstimates) {
