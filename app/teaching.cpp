@@ -294,7 +294,7 @@ void TeachingViews::draw_split_image(const ui::Viewport& where, float exposure_e
 
 bool TeachingViews::wants_frames() const {
   return new_image_ || split_.divider.dragging || (lab_open_ && lab_.running && lab_.count() < lab_.max_samples) ||
-         (lab_open_ && lab_.pi.n.empty()) || probe_.chi_running();
+         (lab_open_ && lab_.pi_job.valid()) || probe_.chi_running();
 }
 
 }  // namespace pdflab

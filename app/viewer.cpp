@@ -34,6 +34,7 @@
 #include <future>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include <time.h>
 
@@ -116,6 +117,12 @@ struct Viewer::Impl {
     int key = 0, mods = 0;
   };
   std::vector<KeyPress> keys;  // pressed since the last frame, from the GLFW callback
+  GLFWkeyfun imgui_key_callback = nullptr;  // ImGui's, which calls ours first
+  struct Release {
+    int key = 0, scancode = 0, mods = 0;
+  };
+  std::vector<int> pressed_this_frame;
+  std::vector<Release> deferred_releases;
   // Redrawing costs CPU time the render threads could use (and llvmpipe draws
   // on the CPU), so a frame is drawn only when something on it can change.
   std::uint64_t input_events = 0, seen_input_events = 0;
@@ -297,6 +304,20 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;
   ImGui_ImplGlfw_InitForOpenGL(window, true);
+  // ImGui 1.86 reads keys as held or not at each frame: a key pressed and
+  // released between two frames (xdotool, a fast typist, a busy frame) would
+  // never be seen, so Enter in a field or Ctrl+A could be lost. Releases of keys
+  // pressed since the last frame reach ImGui one frame late instead.
+  imgui_key_callback = glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int scancode, int action, int mods) {
+    Impl& v = *self(w);
+    if (action == GLFW_RELEASE &&
+        std::find(v.pressed_this_frame.begin(), v.pressed_this_frame.end(), key) != v.pressed_this_frame.end()) {
+      v.deferred_releases.push_back({key, scancode, mods});
+      return;
+    }
+    if (action == GLFW_PRESS) v.pressed_this_frame.push_back(key);
+    if (v.imgui_key_callback) v.imgui_key_callback(w, key, scancode, action, mods);
+  });
   ImGui_ImplOpenGL3_Init("#version 330 core");
   imgui_ready = true;
 
@@ -782,6 +803,10 @@ bool Viewer::frame(bool paced, bool force_draw) {
   const double cpu0 = thread_cpu_ms();
   v.report.new_image = false;
   v.report.drawn = false;
+  // Last frame's quick releases first (see open_window), then the new events.
+  v.pressed_this_frame.clear();
+  for (const Impl::Release& r : std::exchange(v.deferred_releases, {}))
+    if (v.imgui_key_callback) v.imgui_key_callback(v.window, r.key, r.scancode, GLFW_RELEASE, r.mods);
   glfwPollEvents();
   for (const Impl::KeyPress& k : v.keys) v.on_key(k.key, k.mods);
   v.keys.clear();

@@ -6,12 +6,12 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libglfw3-dev libimgui-dev libglm-dev libstb-dev python3-glad python3-jinja2
-  nlohmann-json3-dev libcli11-dev libpcg-cpp-dev
+  nlohmann-json3-dev libcli11-dev libpcg-cpp-dev libmuparser-dev   # libmuparser: the 1D lab's typed f(x)
   libopenexr-dev openexr zlib1g-dev   # EXR output (openexr: exrheader, which a test reads our files with); film checksums
   parallel                             # scripts/render_parallel.sh fans a render out over job slots or machines
   libgtest-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev   # the fuzzer: clang's libFuzzer and sanitizer runtimes (a recommend, not a dependency)
-  xvfb xauth mesa-utils libgl1-mesa-dri xdotool imagemagick x11-apps
+  xvfb xauth mesa-utils libgl1-mesa-dri xdotool imagemagick x11-apps xclip
 )
 
 missing=()

@@ -1,6 +1,9 @@
 // The 1D lab: each inverse CDF against its CDF, estimators of known
 // integrals, zero variance when p is proportional to f, and stratified pi
-// estimates whose error falls faster than 1/sqrt(N).
+// estimates whose error falls faster than 1/sqrt(N); f(x) typed as an
+// expression, and adaptive quadrature against closed forms.
+#include "renderer/error.h"
+#include "renderer/lab/expression.h"
 #include "renderer/lab/lab1d.h"
 #include "renderer/sampling/rng.h"
 
@@ -8,6 +11,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace pdflab::lab {
@@ -127,3 +131,72 @@ TEST(Lab1d, StratifiedPiErrorFallsFasterThanOneOverSqrtN) {
 
 }  // namespace
 }  // namespace pdflab::lab
+
+// --- f(x) typed as an expression, and the exact integral by quadrature ---
+
+namespace {
+
+std::string parse_error(const std::string& text) {
+  try {
+    (void)pdflab::lab::Expression::parse(text);
+  } catch (const pdflab::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(LabExpression, EvaluatesLikeTheFixedIntegrands) {
+  using namespace pdflab::lab;
+  const Expression square = Expression::parse("x^2");
+  const Expression cosine = Expression::parse("cos(x)");
+  for (double x : {0.0, 0.3, 1.0, 1.7, 2.0}) {
+    EXPECT_NEAR(square(x), integrand(Integrand::Square, x), 1e-14);
+    EXPECT_NEAR(cosine(x), integrand(Integrand::Cosine, x), 1e-14);
+  }
+  EXPECT_NEAR(Expression::parse("pi")(0.0), std::numbers::pi, 1e-15);
+  // A copy of the function evaluates on its own parser: the original's x is untouched.
+  const auto f = square.function();
+  EXPECT_DOUBLE_EQ(f(3.0), 9.0);
+  EXPECT_DOUBLE_EQ(square(0.5), 0.25);
+}
+
+TEST(LabExpression, BadTextGetsAMessageNamingIt) {
+  EXPECT_NE(parse_error("sin(").find("f(x) = 'sin('"), std::string::npos) << parse_error("sin(");
+  EXPECT_NE(parse_error("y*2").find("'y*2'"), std::string::npos);
+  EXPECT_NE(parse_error("x +* 2"), "");
+  EXPECT_NE(parse_error("   ").find("empty"), std::string::npos);
+  EXPECT_NE(parse_error("1/0").find("no finite value"), std::string::npos) << parse_error("1/0");
+  EXPECT_EQ(parse_error("exp(-x)*x^3"), "");
+}
+
+TEST(LabQuadrature, MatchesClosedForms) {
+  using namespace pdflab::lab;
+  for (int i = 0; i < static_cast<int>(Integrand::Count); ++i) {
+    const auto f = static_cast<Integrand>(i);
+    EXPECT_NEAR(integrate([f](double x) { return integrand(f, x); }, kLow, kHigh), exact_integral(f), 1e-7)
+        << integrand_name(f);
+  }
+  // sin^2(pi x) over [0, 2] is 1; x^3 e^-x over [0, 2] is 6 - 38/e^2.
+  EXPECT_NEAR(integrate(Expression::parse("sin(pi*x)^2").function(), 0.0, 2.0), 1.0, 1e-9);
+  EXPECT_NEAR(integrate(Expression::parse("exp(-x)*x^3").function(), 0.0, 2.0), 6.0 - 38.0 / std::exp(2.0), 1e-9);
+  // A jump: the adaptive splitting finds it.
+  EXPECT_NEAR(integrate(Expression::parse("x < 0.3 ? 1 : 0").function(), 0.0, 2.0), 0.3, 1e-6);
+  // Not finite somewhere sampled: NaN, for the caller to say so.
+  EXPECT_TRUE(std::isnan(integrate([](double x) { return 1.0 / x; }, 0.0, 2.0)));
+  // A wildly oscillating f ends within the evaluation budget.
+  const double fast = integrate([](double x) { return std::sin(1e6 * x); }, 0.0, 2.0);
+  EXPECT_TRUE(std::isfinite(fast));
+}
+
+TEST(LabExpression, TheEstimatorOfATypedFMatchesTheFixedOne) {
+  using namespace pdflab::lab;
+  Estimator fixed(Integrand::Square, Pdf::Linear);
+  Estimator typed(Expression::parse("x*x").function(), Pdf::Linear);
+  for (int i = 1; i < 1000; ++i) {
+    const double u = (i * 0.6180339887498949) - std::floor(i * 0.6180339887498949);
+    EXPECT_NEAR(fixed.add(u), typed.add(u), 1e-12);
+  }
+  EXPECT_NEAR(fixed.mean(), typed.mean(), 1e-12);
+}

@@ -5,6 +5,7 @@
 #include "ui/teach_draw.h"
 
 #include <imgui.h>
+#include <imgui_stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -61,13 +62,28 @@ PiStudy run_pi_study(int max_power_of_four, int seeds) {
 }
 
 void Lab1dState::select(lab::Integrand f, lab::Pdf p) {
+  if (f != integrand) typed.reset();
   integrand = f;
   pdf = p;
   reset();
 }
 
+bool Lab1dState::type_f(const std::string& text) {
+  try {
+    lab::Expression e = lab::Expression::parse(text);
+    typed_exact = lab::integrate(e.function(), lab::kLow, lab::kHigh);
+    typed = std::move(e);
+    f_error.clear();
+  } catch (const std::exception& e) {
+    f_error = e.what();
+    return false;
+  }
+  reset();
+  return true;
+}
+
 void Lab1dState::reset() {
-  estimator = lab::Estimator(integrand, pdf);
+  estimator = typed ? lab::Estimator(typed->function(), pdf) : lab::Estimator(integrand, pdf);
   std::fill(histogram.begin(), histogram.end(), 0);
   history.clear();
   next_record_ = 1;
@@ -99,7 +115,7 @@ void curves_plot(const Lab1dState& s, ImVec2 size) {
   const std::vector<double> xs = linspace(lab::kLow, lab::kHigh, 241);
   std::vector<double> fs, ps;
   for (double x : xs) {
-    fs.push_back(lab::integrand(s.integrand, x));
+    fs.push_back(s.f(x));
     ps.push_back(lab::pdf(s.pdf, x));
   }
   std::vector<double> all = fs;
@@ -108,7 +124,7 @@ void curves_plot(const Lab1dState& s, ImVec2 size) {
   const draw::Plot plot("f(x) and p(x)", size, {lab::kLow, lab::kHigh}, draw::fit_axis(all, false), "x");
   plot.line(xs, fs, kF, 2.0f);
   plot.line(xs, ps, kP, 2.0f);
-  plot.legend({{"f(x) = " + std::string(lab::integrand_name(s.integrand)), kF},
+  plot.legend({{"f(x) = " + s.f_name(), kF},
                {"p(x) " + std::string(lab::pdf_name(s.pdf)), kP}},
               true);
 }
@@ -140,7 +156,7 @@ void estimate_plot(const Lab1dState& s, ImVec2 size) {
     lo.push_back(h.mean - h.standard_error);
     hi.push_back(h.mean + h.standard_error);
   }
-  const double exact = lab::exact_integral(s.integrand);
+  const double exact = s.exact();
   std::vector<double> all = mean;
   all.push_back(exact);
   // The first few estimates can be wild; keep the exact value in clear view.
@@ -155,6 +171,37 @@ void estimate_plot(const Lab1dState& s, ImVec2 size) {
   plot.hline(exact, kExact);
   plot.line(ns, mean, kF, 2.0f);
   plot.legend({{"estimate", kF}, {"+- 1 std. error", IM_COL32(90, 170, 255, 120)}, {"exact", kExact}});
+}
+
+// |estimate - exact| against N for the current f and p, log-log, beside the
+// standard error and a 1/sqrt(N) guide: a finite variance shows as slope -1/2.
+void error_plot(const Lab1dState& s, ImVec2 size) {
+  const double exact = s.exact();
+  std::vector<double> ns, err, se;
+  for (const LabHistoryPoint& h : s.history) {
+    const double e = std::abs(h.mean - exact);
+    if (!(e > 0.0) || !std::isfinite(e) || !(h.standard_error > 0.0)) continue;
+    ns.push_back(static_cast<double>(h.n));
+    err.push_back(e);
+    se.push_back(h.standard_error);
+  }
+  if (ns.size() < 2 || !std::isfinite(exact)) {
+    ImGui::TextColored(kDim, std::isfinite(exact) ? "|error| vs N: collecting samples..."
+                                                  : "|error| vs N: the exact integral is not finite");
+    ImGui::Dummy(ImVec2(size.x, size.y - ImGui::GetTextLineHeightWithSpacing()));
+    return;
+  }
+  std::vector<double> guide;
+  for (double n : ns) guide.push_back(se.front() * std::sqrt(ns.front() / n));
+  std::vector<double> all = err;
+  all.insert(all.end(), se.begin(), se.end());
+  const draw::Plot plot("|estimate - exact| vs N (log-log)", size, {1.0, std::max(10.0, ns.back()), true},
+                        draw::fit_axis(all, true), "N (log)");
+  plot.line(ns, guide, IM_COL32(170, 170, 170, 150), 1.0f);
+  plot.line(ns, se, IM_COL32(90, 170, 255, 160), 1.4f);
+  plot.line(ns, err, kPlain, 2.0f);
+  plot.legend({{"|error|", kPlain}, {"standard error", IM_COL32(90, 170, 255, 160)},
+               {"~N^-1/2", IM_COL32(170, 170, 170, 150)}});
 }
 
 void pi_plot(Lab1dState& s, ImVec2 size) {
@@ -204,14 +251,24 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
 
   lab::Integrand f = s.integrand;
   lab::Pdf p = s.pdf;
+  bool pick = false;  // a fixed f chosen (also the one already selected, to leave a typed one)
   ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8.0f);
-  if (ImGui::BeginCombo("f(x)", std::string(lab::integrand_name(f)).c_str())) {
+  if (ImGui::BeginCombo("f(x)", s.typed ? "typed" : std::string(lab::integrand_name(f)).c_str())) {
     for (int i = 0; i < static_cast<int>(lab::Integrand::Count); ++i) {
       const auto v = static_cast<lab::Integrand>(i);
-      if (ImGui::Selectable(std::string(lab::integrand_name(v)).c_str(), v == f)) f = v;
+      if (ImGui::Selectable(std::string(lab::integrand_name(v)).c_str(), !s.typed && v == f)) {
+        f = v;
+        pick = true;
+      }
     }
     ImGui::EndCombo();
   }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 10.0f);
+  if (ImGui::InputTextWithHint("= f(x) (Enter)", "e.g. sin(pi*x)^2", &s.f_field, ImGuiInputTextFlags_EnterReturnsTrue))
+    s.type_f(s.f_field);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Any f of x on [0, 2]: + - * / ^, sin cos tan exp ln log10 sqrt abs min max, pi, e");
   ImGui::SameLine();
   ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8.0f);
   if (ImGui::BeginCombo("p(x)", std::string(lab::pdf_name(p)).c_str())) {
@@ -221,7 +278,8 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
     }
     ImGui::EndCombo();
   }
-  if (f != s.integrand || p != s.pdf) s.select(f, p);
+  if (pick && s.typed) s.typed.reset();
+  if (pick || f != s.integrand || p != s.pdf) s.select(f, p);
   ImGui::SameLine();
   if (ImGui::Button(s.running ? "Pause" : "Run")) s.running = !s.running;
   ImGui::SameLine();
@@ -230,10 +288,14 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
   ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
   ImGui::SliderInt("samples/frame", &s.samples_per_frame, 1, 4096, "%d", ImGuiSliderFlags_Logarithmic);
 
-  const double exact = lab::exact_integral(s.integrand);
-  ImGui::Text("N = %llu   estimate %.5f +- %.5f   exact %.5f   error %+.2e", static_cast<unsigned long long>(s.count()),
-              s.estimator.mean(), s.estimator.standard_error(), exact, s.estimator.mean() - exact);
-  if (!lab::has_finite_variance(s.integrand, s.pdf)) {
+  if (!s.f_error.empty()) ImGui::TextColored(kRed, "%s", s.f_error.c_str());
+  const double exact = s.exact();
+  ImGui::Text("N = %llu   estimate %.5f +- %.5f   exact %.5f%s   error %+.2e",
+              static_cast<unsigned long long>(s.count()), s.estimator.mean(), s.estimator.standard_error(), exact,
+              s.typed ? " (adaptive quadrature)" : "", s.estimator.mean() - exact);
+  if (s.typed) {
+    ImGui::TextColored(kDim, "A typed f: whether f/p has a finite variance is for the error plot to show.");
+  } else if (!lab::has_finite_variance(s.integrand, s.pdf)) {
     ImGui::TextColored(kRed,
                        "Infinite variance: p(x) falls to zero faster than f(x) somewhere. Still unbiased, but the\n"
                        "standard error is not to be trusted and the error does not fall like 1/sqrt(N).");
@@ -252,7 +314,16 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
   histogram_plot(s, cell);
   estimate_plot(s, cell);
   ImGui::SameLine();
-  pi_plot(s, cell);
+  ImGui::BeginGroup();
+  int which = s.plot_pi ? 1 : 0;
+  ImGui::RadioButton("error of this f, p", &which, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("pi, stratified or not", &which, 1);
+  s.plot_pi = which == 1;
+  const ImVec2 rest(cell.x, cell.y - ImGui::GetFrameHeightWithSpacing());
+  if (s.plot_pi) pi_plot(s, rest);
+  else error_plot(s, rest);
+  ImGui::EndGroup();
   ImGui::End();
 }
 

@@ -2,10 +2,13 @@
 // The 1D lab: the book's chapters before the path tracer, in a window of its
 // own. The state is plain data that advances by a number of samples per
 // frame; drawing reads it. Tests drive the state without a window.
+#include "renderer/lab/expression.h"
 #include "renderer/lab/lab1d.h"
 
 #include <cstdint>
 #include <future>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace pdflab::ui {
@@ -41,9 +44,21 @@ struct Lab1dState {
 
   PiStudy pi;
   std::future<PiStudy> pi_job;
+  bool plot_pi = false;  // the fourth plot: pi's study instead of this pair's error
+
+  // f typed as an expression: used while `typed` holds one, else `integrand`.
+  std::string f_field = "x^2";  // the text field
+  std::string f_error;          // why the last text was refused (the lab keeps its f)
+  std::optional<lab::Expression> typed;
+  double typed_exact = 0.0;  // its integral by adaptive quadrature (NaN: not finite)
 
   // Changing f or p (or the seed) starts over: the old samples estimate another integral.
   void select(lab::Integrand f, lab::Pdf p);
+  // Parses `text` as f(x); on success uses it (and starts over), else sets f_error.
+  bool type_f(const std::string& text);
+  double f(double x) const { return typed ? (*typed)(x) : lab::integrand(integrand, x); }
+  double exact() const { return typed ? typed_exact : lab::exact_integral(integrand); }
+  std::string f_name() const { return typed ? typed->text() : std::string(lab::integrand_name(integrand)); }
   void reset();
   // Draws `count` samples by the inverse CDF (stops at max_samples).
   void step(int count);

@@ -109,7 +109,7 @@ double Estimator::add(double u) {
   const double density = pdf(p_, x);
   // x has density zero only at an end point of the interval (u = 0 for the
   // linear and quadratic pdfs), a set of measure zero: it contributes f/p = 0.
-  const double value = density > 0.0 ? integrand(f_, x) / density : 0.0;
+  const double value = density > 0.0 ? f_(x) / density : 0.0;
   ++n_;
   sum_ += value;
   sum_sq_ += value * value;

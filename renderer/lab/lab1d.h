@@ -5,6 +5,7 @@
 // without stratification. The viewer's 1D lab draws these; tests check them.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -35,7 +36,9 @@ double inverse_cdf(Pdf p, double u);  // u in [0, 1): the sample
 // Running estimate of the integral of f with samples from p.
 class Estimator {
  public:
-  Estimator(Integrand f, Pdf p) : f_(f), p_(p) {}
+  Estimator(Integrand f, Pdf p) : f_([f](double x) { return integrand(f, x); }), p_(p) {}
+  // Any f on [kLow, kHigh], e.g. a typed Expression's function().
+  Estimator(std::function<double(double)> f, Pdf p) : f_(std::move(f)), p_(p) {}
   // Adds the sample x = inverse_cdf(p, u); returns f(x) / p(x).
   double add(double u);
   std::uint64_t count() const { return n_; }
@@ -45,7 +48,7 @@ class Estimator {
   void reset() { n_ = 0, sum_ = 0.0, sum_sq_ = 0.0; }
 
  private:
-  Integrand f_;
+  std::function<double(double)> f_;
   Pdf p_;
   std::uint64_t n_ = 0;
   double sum_ = 0.0, sum_sq_ = 0.0;

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # GUI test of the teaching views under Xvfb, driven with xdotool: split screen
 # (S, then dragging the divider), pixel probe (P, a click, C for chi-square)
-# and the 1D lab (L). Each view is captured; each capture must be non-blank
+# and the 1D lab (L, then a bad and a good f(x) typed). Each view is captured; each capture must be non-blank
 # and differ from the one before it.
 #   gui_teaching.sh PDFLAB SCENE ARTIFACT_DIR [DOCS_DIR]
 # With DOCS_DIR the views are rendered longer and saved there as
-# view_split.png, view_probe.png, view_lab1d.png.
+# view_split.png, view_probe.png, view_lab1d.png (with a typed f(x)).
 # Exit 77 only when xvfb-run itself is missing.
 set -euo pipefail
 
@@ -102,7 +102,32 @@ sleep 1
 shot lab_later
 # The running estimate keeps drawing samples: the plots move.
 changed "$art/lab.png" "$art/lab_later.png"
-[ -n "$docs" ] && cp "$art/lab_later.png" "$docs/view_lab1d.png"
+
+echo "== 1D lab: f(x) typed as an expression"
+# The f(x) field, right of the drop-down in the lab's first row.
+xdotool mousemove 250 48 click 1
+sleep 0.2
+xdotool key --window "$wid" ctrl+a
+sleep 0.2
+xdotool type --window "$wid" "sin(pi*"
+xdotool key --window "$wid" Return
+xdotool mousemove 2 2
+sleep 1
+alive "$viewer" "a bad expression"
+shot lab_bad
+changed "$art/lab_later.png" "$art/lab_bad.png"
+xdotool mousemove 250 48 click 1
+sleep 0.2
+xdotool key --window "$wid" ctrl+a
+sleep 0.2
+xdotool type --window "$wid" "sin(pi*x)^2"
+xdotool key --window "$wid" Return
+xdotool mousemove 2 2
+sleep "$settle"
+shot lab_typed
+not_blank "$art/lab_typed.png"
+changed "$art/lab_bad.png" "$art/lab_typed.png"
+[ -n "$docs" ] && cp "$art/lab_typed.png" "$docs/view_lab1d.png"
 
 quit_viewer "$wid" "$viewer"
 trap - EXIT

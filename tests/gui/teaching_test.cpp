@@ -223,6 +223,24 @@ TEST(ProbeProjection, ACheckStartedBeforeANewProbeIsDropped) {
   EXPECT_GT(s.technique_counts[3], 0);
 }
 
+TEST(Lab1d, ATypedFReplacesTheFixedOneAndABadOneKeepsIt) {
+  Lab1dState s;
+  s.step(1000);
+  ASSERT_TRUE(s.type_f("sin(pi*x)^2"));
+  EXPECT_EQ(s.count(), 0u);  // started over
+  EXPECT_NEAR(s.exact(), 1.0, 1e-9);
+  EXPECT_EQ(s.f_name(), "sin(pi*x)^2");
+  s.step(20000);
+  EXPECT_NEAR(s.estimator.mean(), 1.0, 5.0 * s.estimator.standard_error());
+  EXPECT_FALSE(s.type_f("sin(pi*"));
+  EXPECT_NE(s.f_error.find("sin(pi*"), std::string::npos);
+  EXPECT_EQ(s.f_name(), "sin(pi*x)^2");  // still the last good one
+  EXPECT_GT(s.count(), 0u);              // and its samples
+  s.select(lab::Integrand::Cosine, s.pdf);
+  EXPECT_FALSE(s.typed);
+  EXPECT_NEAR(s.exact(), std::sin(2.0), 1e-12);
+}
+
 TEST(Lab1d, BinsCoverTheIntervalHalfOpen) {
   EXPECT_EQ(lab_bin(0.0, 40), 0);
   EXPECT_EQ(lab_bin(0.0499, 40), 0);
