@@ -11,10 +11,10 @@
 namespace pdflab {
 
 // Image size limits. A side may be up to 16384 pixels, but the film costs
-// kFilmBytesPerPixel (sum and sum of squares in double, a count) and a render
-// holds about as much again in float images (the published pass, the copy that
-// is written, the encoded file), so 16384 x 16384 would need about 25 GiB.
-// The pixel budget caps a render near 2 GiB: 4096 x 4096, 8192 x 2048, ...
+// kFilmBytesPerPixel (sum and sum of squares in double, a count) plus a drop
+// mask byte, and a headless render holds little else (bench/bench_memory), so
+// 16384 x 16384 would need about 14 GiB. The pixel budget caps a render near
+// 1 GiB: 4096 x 4096, 8192 x 2048, ...
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 24;
 inline constexpr std::int64_t kFilmBytesPerPixel = 6 * sizeof(double) + sizeof(std::uint32_t);

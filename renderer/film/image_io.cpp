@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -204,7 +205,33 @@ void write_film_image(const std::string& path, const Film& film, Transfer transf
       file.commit();
       return;
     }
-    case ImageFormat::Png:
+    case ImageFormat::Png: {
+      // Tone-mapped straight from the film (3 bytes a pixel, not a float image
+      // first), and stb's encoded file goes to disk without another copy.
+      const std::size_t pixels = film.pixel_count();
+      std::vector<std::uint8_t> bytes(3 * pixels);
+      for (std::size_t p = 0; p < pixels; ++p) {
+        double m[3];
+        film.mean(p, m);
+        for (std::size_t c = 0; c < 3; ++c) bytes[3 * p + c] = tone_map_channel(static_cast<float>(m[c]), transfer);
+      }
+      struct Sink {
+        AtomicFile file;
+        std::exception_ptr error;
+      } sink{AtomicFile(path), nullptr};
+      const auto put = [](void* context, void* data, int size) {
+        auto* s = static_cast<Sink*>(context);
+        try {  // no exception may cross stb's C frames
+          if (!s->error) s->file.write(data, static_cast<std::size_t>(size));
+        } catch (...) {
+          s->error = std::current_exception();
+        }
+      };
+      if (!stbi_write_png_to_func(put, &sink, w, h, 3, bytes.data(), w * 3)) throw IoError("PNG encoding failed");
+      if (sink.error) std::rethrow_exception(sink.error);
+      sink.file.commit();
+      return;
+    }
     case ImageFormat::Hdr: write_image(path, film.mean_rgb(), w, h, transfer); return;
   }
 }

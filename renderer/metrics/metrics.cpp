@@ -120,20 +120,13 @@ double mean_relative_standard_error(const Film& film, double epsilon) {
   return noise_summary(film, map, epsilon).mean_relative_standard_error;
 }
 
-double estimated_relmse(const Film& film, double epsilon) {
-  std::vector<float> map;
-  return noise_summary(film, map, epsilon).estimated_relmse;
-}
+namespace {
 
-std::vector<float> relative_standard_error_map(const Film& film, double epsilon) {
-  std::vector<float> map;
-  (void)noise_summary(film, map, epsilon);
-  return map;
-}
-
-NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon, std::vector<float>* mean_rgb) {
+// The sweep behind noise_summary; `map` and `mean_rgb` may be null (then no
+// image-sized buffer is touched: a headless render's estimate).
+NoiseSummary sweep_noise(const Film& film, std::vector<float>* map, double epsilon, std::vector<float>* mean_rgb) {
   const std::size_t pixels = film.pixel_count();
-  map.assign(pixels, 0.0f);
+  if (map) map->assign(pixels, 0.0f);
   if (mean_rgb) mean_rgb->resize(3 * pixels);
   double rse_sum = 0.0, rel_sum = 0.0;
   std::size_t n = 0;
@@ -147,7 +140,7 @@ NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double eps
       for (int c = 0; c < 3; ++c) (*mean_rgb)[3 * p + c] = static_cast<float>(m[c]);
     if (count < 2) continue;
     const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
-    map[p] = static_cast<float>(rse);
+    if (map) (*map)[p] = static_cast<float>(rse);
     rse_sum += rse;
     for (int c = 0; c < 3; ++c) rel_sum += v[c] / (m[c] * m[c] + epsilon);
     ++n;
@@ -158,6 +151,22 @@ NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double eps
     out.estimated_relmse = rel_sum / (3.0 * static_cast<double>(n));
   }
   return out;
+}
+
+}  // namespace
+
+double estimated_relmse(const Film& film, double epsilon) {
+  return sweep_noise(film, nullptr, epsilon, nullptr).estimated_relmse;
+}
+
+std::vector<float> relative_standard_error_map(const Film& film, double epsilon) {
+  std::vector<float> map;
+  (void)noise_summary(film, map, epsilon);
+  return map;
+}
+
+NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon, std::vector<float>* mean_rgb) {
+  return sweep_noise(film, &map, epsilon, mean_rgb);
 }
 
 }  // namespace pdflab
