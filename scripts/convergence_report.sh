@@ -1,18 +1,21 @@
 #!/usr/bin/env bash
-# Renders references for every shipped scene (assets/scenes/*.json, or the ones
-# named in SCENES), benchmarks every strategy the binary accepts at equal time
-# against them, and
-# writes docs/convergence.md with the tables, the plots (SVG and PNG) and the
-# interpretation kept in scripts/convergence_notes.md (prose lives there so a
-# re-run refreshes the numbers without losing it).
+# Makes a reference with `pdflab reference` for every shipped scene
+# (assets/scenes/*.json, or the ones named in SCENES), benchmarks every strategy
+# the binary accepts at equal time against it with several independent seeds,
+# and writes docs/convergence.md with the tables (means and 95% intervals over
+# the seeds), the plots (SVG and PNG) and the interpretation kept in
+# scripts/convergence_notes.md (prose lives there so a re-run refreshes the
+# numbers without losing it).
 #
-#   bash scripts/convergence_report.sh          # about 10 minutes on 2 cores
+#   bash scripts/convergence_report.sh     # defaults: about 25 minutes on 2 cores
+#   SIZE=100 BENCH_SECONDS=1 REF_SECONDS=40 bash scripts/convergence_report.sh   # about 11 minutes
 #   SCENES="cornell_book small_light" bash scripts/convergence_report.sh
 #
 # Settings (environment): PDFLAB (binary, default build/release/app/pdflab),
-# SIZE (image side, 200), REF_SPP (reference samples per pixel for every
-# scene; default 2048, 8192 for the small-light box, whose reference needs more),
-# BENCH_SECONDS (render time per strategy, 4), THREADS (0: all cores).
+# SIZE (image side, 200), BENCH_SECONDS (render time per strategy and seed, 4),
+# SEEDS (independent runs per strategy, 4: seeds 2, 3, ...), REF_SECONDS (the
+# reference's rendering time; default 40 x BENCH_SECONDS, so that it has about
+# 40 times the samples of its own strategy's run), THREADS (0: all cores).
 # NOTES_ONLY=1 rebuilds docs/convergence.md from the last run's files (after
 # editing the notes) without rendering.
 set -euo pipefail
@@ -21,9 +24,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 PDFLAB=${PDFLAB:-build/release/app/pdflab}
 SIZE=${SIZE:-200}
 BENCH_SECONDS=${BENCH_SECONDS:-4}
+SEEDS=${SEEDS:-4}
+REF_SECONDS=${REF_SECONDS:-$(awk -v b="$BENCH_SECONDS" 'BEGIN { print 40 * b }')}
 THREADS=${THREADS:-0}
-# The reference strategy: the book's mixture, unbiased and tested against the
-# others; seed 1 (bench uses seed 2, so no sample is shared with a benchmark run).
+# What `pdflab reference` renders with by default on these scenes (the most
+# efficient unbiased strategy in the boxes); the table's reference share says
+# whether its noise is small enough.
 REF_STRATEGY="mix:cosine=0.5,light=0.5"
 if [[ -n ${SCENES:-} ]]; then
   read -r -a SCENES <<<"$SCENES"
@@ -34,12 +40,7 @@ else
     [[ $name == cornell_book || $name == small_light ]] || SCENES+=("$name")
   done
 fi
-# The reference's noise adds to every measured relMSE about (run spp / reference
-# spp) times the reference strategy's own relMSE; these keep that near a tenth
-# for the reference strategy's own row at the default time.
-declare -A REF_SPP_OF=()
-for scene in "${SCENES[@]}"; do REF_SPP_OF[$scene]=${REF_SPP:-2048}; done
-[[ -n ${REF_SPP_OF[small_light]:-} && -z ${REF_SPP:-} ]] && REF_SPP_OF[small_light]=8192
+(( SEEDS >= 2 )) || { echo "convergence_report: SEEDS must be at least 2 (intervals need them)" >&2; exit 2; }
 
 die() { echo "convergence_report: $*" >&2; exit 2; }
 [[ -x $PDFLAB ]] || die "no binary at $PDFLAB (cmake --preset release && cmake --build --preset release)"
@@ -48,6 +49,8 @@ CONVERT=$(command -v convert) || die "ImageMagick's convert is needed for the PN
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# The report's own cache: it never uses (or fills) the user's.
+cache=$work/cache
 
 # A strategy exists when a one-sample render accepts it; new techniques join
 # the report without editing this script.
@@ -72,16 +75,27 @@ else
 start=$(date +%s)
 for scene in "${SCENES[@]}"; do
   file=assets/scenes/$scene.json
-  echo "== $scene: reference, ${REF_SPP_OF[$scene]} spp at ${SIZE}x$SIZE" >&2
-  "$PDFLAB" render --scene "$file" --strategy "$REF_STRATEGY" --spp "${REF_SPP_OF[$scene]}" --seed 1 \
-    --width "$SIZE" --height "$SIZE" --threads "$THREADS" --quiet --out "$work/$scene.pfm" >&2
-  "$PDFLAB" render --scene "$file" --strategy "$REF_STRATEGY" --spp 64 --seed 1 \
-    --width "$SIZE" --height "$SIZE" --threads "$THREADS" --quiet --out "docs/convergence_${scene}_preview.png" >&2
-  echo "== $scene: ${#strategies[@]} strategies, $BENCH_SECONDS s each" >&2
-  "$PDFLAB" bench --scene "$file" --strategies "$strategy_list" --seconds "$BENCH_SECONDS" \
-    --reference "$work/$scene.pfm" --threads "$THREADS" --quiet \
-    --csv "docs/convergence_$scene.csv" --plot "docs/convergence_$scene.svg" \
-    --curves "docs/convergence_${scene}_curves.csv" | tee "$work/$scene.txt" >&2
+  echo "== $scene: reference, $REF_SECONDS s at ${SIZE}x$SIZE" >&2
+  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --seconds "$REF_SECONDS" \
+    --threads "$THREADS" --cache-dir "$cache" --out "$work/$scene.pfm" --quiet >&2
+  cp "$work/$scene.json" "docs/convergence_${scene}_reference.json"
+  "$CONVERT" "$work/$scene.pfm" -gamma 2 -resize 200x200 "docs/convergence_${scene}_preview.png" 2>/dev/null ||
+    "$PDFLAB" render --scene "$file" --strategy "$REF_STRATEGY" --spp 64 --width "$SIZE" --height "$SIZE" \
+      --threads "$THREADS" --quiet --out "docs/convergence_${scene}_preview.png" >&2
+  rm -f "docs/convergence_${scene}.csv"
+  for ((k = 0; k < SEEDS; ++k)); do
+    seed=$((2 + k))
+    echo "== $scene: ${#strategies[@]} strategies, $BENCH_SECONDS s each, seed $seed" >&2
+    extra=()
+    # The first seed's run also draws the plot and keeps every checkpoint.
+    ((k == 0)) && extra=(--plot "docs/convergence_$scene.svg" --curves "docs/convergence_${scene}_curves.csv")
+    "$PDFLAB" bench --scene "$file" --strategies "$strategy_list" --seconds "$BENCH_SECONDS" --seed "$seed" \
+      --reference auto --width "$SIZE" --height "$SIZE" --cache-dir "$cache" --threads "$THREADS" --quiet \
+      --csv "$work/$scene.$seed.csv" "${extra[@]}" >&2
+    # One CSV for the scene: the bench columns with the seed in front.
+    awk -v seed="$seed" -v first=$((k == 0)) 'NR == 1 { if (first) print "seed," $0; next } { print seed "," $0 }' \
+      "$work/$scene.$seed.csv" >>"docs/convergence_${scene}.csv"
+  done
   "$CONVERT" -density 96 "docs/convergence_$scene.svg" "$work/$scene.png"
   mv "$work/$scene.png" "docs/convergence_$scene.png"
 done
@@ -89,75 +103,117 @@ elapsed=$(( $(date +%s) - start ))
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 run_date=$(date -u +%Y-%m-%d)
 {
-  echo "elapsed=$elapsed commit=$commit run_date=$run_date SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS"
+  echo "elapsed=$elapsed commit=$commit run_date=$run_date SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS SEEDS=$SEEDS"
+  echo "REF_SECONDS=$REF_SECONDS"
   echo "SCENES=(${SCENES[*]})"
-  printf 'REF_SPP_OF=('
-  for scene in "${SCENES[@]}"; do printf '[%s]=%s ' "$scene" "${REF_SPP_OF[$scene]}"; done
-  echo ')'
   echo "strategies_run=$(printf '%q' "$strategy_list")"
 } > "$run_info"
 fi
 
-# An awk function both tables use: one CSV row into f[], the strategy field
+# An awk function the tables use: one CSV row into f[], the strategy field
 # quoted (mixtures hold commas), the rest plain numbers.
 SPLIT_ROW='
-    function split_row(line, f,   rest, n) {
+    function split_row(line, f,   rest, n, head, i) {
       rest = line
-      if (substr(rest, 1, 1) == "\"") {
-        f[1] = substr(rest, 2, index(substr(rest, 2), "\"") - 1)
-        rest = substr(rest, length(f[1]) + 4)
-        n = split(rest, tail, ",")
-        for (i = 1; i <= n; ++i) f[i + 1] = tail[i]
-        return n + 1
+      n = 0
+      while (substr(rest, 1, 1) != "\"" && index(rest, ",") > 0 && n < 1) {
+        f[++n] = substr(rest, 1, index(rest, ",") - 1)
+        rest = substr(rest, index(rest, ",") + 1)
       }
-      return split(rest, f, ",")
+      if (substr(rest, 1, 1) == "\"") {
+        f[++n] = substr(rest, 2, index(substr(rest, 2), "\"") - 1)
+        rest = substr(rest, length(f[n]) + 4)
+      }
+      m = split(rest, tail, ",")
+      for (i = 1; i <= m; ++i) f[n + i] = tail[i]
+      return n + m
+    }
+    # 95% two-sided Student t quantile for k - 1 degrees of freedom.
+    function t95(k) {
+      if (k <= 2) return 12.706; if (k == 3) return 4.303; if (k == 4) return 3.182; if (k == 5) return 2.776
+      if (k == 6) return 2.571; if (k == 7) return 2.447; if (k == 8) return 2.365; if (k <= 11) return 2.262
+      if (k <= 21) return 2.086; return 1.96
     }
 '
 
-# One markdown table from a bench CSV. The strategy field is quoted (mixtures
-# hold commas); the rest are plain numbers. "vs cosine" is the efficiency ratio.
-table() {
+# The per-scene figures, one line per strategy (in the order run), tab-separated:
+# strategy unbiased spp seconds relmse relmse_ci raw est eff eff_ci ratio ratio_lo ratio_hi share msps ref_noise
+# Means over the seeds; *_ci are 95% t half widths over them; the ratio to
+# cosine is taken seed by seed (independent runs) and averaged.
+aggregate() {
   awk "$SPLIT_ROW"'
     NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
     {
       split_row($0, f)
-      ++rows
-      for (c in col) v[rows, c] = f[col[c]]
-      if (f[col["strategy"]] == "cosine") cosine_eff = f[col["efficiency"]]
+      s = f[col["strategy"]]; seed = f[col["seed"]]
+      if (!(s in seen)) { seen[s] = 1; order[++ns] = s }
+      n[s]++
+      unb[s] = f[col["unbiased"]]
+      e = f[col["efficiency"]] + 0; r = f[col["relmse"]] + 0
+      eff[s, seed] = e; seeds[seed] = 1
+      sum_e[s] += e; sq_e[s] += e * e; sum_r[s] += r; sq_r[s] += r * r
+      sum_raw[s] += f[col["relmse_raw"]]; sum_est[s] += f[col["est_relmse"]]
+      sum_spp[s] += f[col["spp"]]; sum_sec[s] += f[col["seconds"]]; sum_sps[s] += f[col["samples_per_second"]]
+      sum_share[s] += f[col["ref_share"]]
+      ref_noise[s] += f[col["ref_share"]] * f[col["relmse_raw"]]
     }
+    function hw(sum, sq, k,   m, v) { if (k < 2) return 0; m = sum / k; v = (sq - k * m * m) / (k - 1); return t95(k) * sqrt(v > 0 ? v : 0) / sqrt(k) }
     END {
-      print "| strategy | unbiased | spp | seconds | relMSE | est. relMSE | efficiency | vs cosine | M samples/s | dropped |"
-      print "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
-      for (r = 1; r <= rows; ++r) {
-        ratio = cosine_eff > 0 ? sprintf("%.2fx", v[r, "efficiency"] / cosine_eff) : "-"
-        printf "| `%s` | %s | %d | %.2f | %.4g | %.4g | %.4g | %s | %.2f | %d |\n", v[r, "strategy"],
-               v[r, "unbiased"] == 1 ? "yes" : "**no**", v[r, "spp"], v[r, "seconds"], v[r, "relmse"],
-               v[r, "est_relmse"], v[r, "efficiency"], ratio, v[r, "samples_per_second"] / 1e6, v[r, "dropped"]
+      for (i = 1; i <= ns; ++i) {
+        s = order[i]; k = n[s]
+        rs = 0; rq = 0; rk = 0
+        for (seed in seeds) if ((s, seed) in eff && ("cosine", seed) in eff && eff["cosine", seed] > 0) {
+          q = eff[s, seed] / eff["cosine", seed]; rs += q; rq += q * q; ++rk
+        }
+        rm = rk ? rs / rk : 0; rh = hw(rs, rq, rk)
+        printf "%s\t%d\t%.0f\t%.2f\t%.4g\t%.2g\t%.4g\t%.4g\t%.4g\t%.2g\t%.3g\t%.3g\t%.3g\t%.3g\t%.2f\t%.4g\n", s, unb[s],
+               sum_spp[s] / k, sum_sec[s] / k, sum_r[s] / k, hw(sum_r[s], sq_r[s], k), sum_raw[s] / k, sum_est[s] / k,
+               sum_e[s] / k, hw(sum_e[s], sq_e[s], k), rm, (rm - rh > 0 ? rm - rh : 0), rm + rh, sum_share[s] / k,
+               sum_sps[s] / k / 1e6, ref_noise[s] / k
       }
     }' "$1"
 }
 
-# Sentences computed from the numbers, so they cannot disagree with the table:
-# the most efficient unbiased strategy, how far the reference-free estimate is
-# from the measured relMSE for cosine and for the winner, and the reference's
-# share of the error (from the run of the reference's own strategy).
-summary() {
-  awk -v ref_spp="$2" -v ref_strategy="$REF_STRATEGY" "$SPLIT_ROW"'
-    NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
+# One markdown table from the aggregate.
+table() {
+  aggregate "$1" | awk -F '\t' '
+    BEGIN {
+      print "| strategy | unbiased | spp | seconds | relMSE (95% CI) | raw relMSE | est. relMSE | efficiency (95% CI) | vs cosine (95% CI) | ref. share | M samples/s |"
+      print "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    }
     {
-      split_row($0, f)
-      s = f[col["strategy"]]; e = f[col["efficiency"]] + 0
-      if (s == "cosine") { ce = e; cm = f[col["relmse"]]; cest = f[col["est_relmse"]] }
-      if (s == ref_strategy) { floor_relmse = f[col["est_relmse"]] * f[col["spp"]] / ref_spp; rm = f[col["relmse"]] }
-      if (f[col["unbiased"]] == 1 && e > best) { best = e; bs = s; bm = f[col["relmse"]]; best_est = f[col["est_relmse"]] }
+      printf "| `%s` | %s | %d | %.2f | %.4g ± %.2g | %.4g | %.4g | %.4g ± %.2g | %.3gx [%.3g, %.3g] | %.1f%% | %.2f |\n",
+             $1, $2 == 1 ? "yes" : "**no**", $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, 100 * $14, $15
+    }'
+}
+
+# Sentences computed from the numbers, so they cannot disagree with the table:
+# the reference and its share of the best row's error, the most efficient
+# unbiased strategy, and how far the film's own estimate is from the measured relMSE.
+summary() {
+  local side=$2
+  local ref_spp ref_seconds ref_est
+  ref_spp=$(sed -n 's/^ *"spp": *\([0-9]*\).*/\1/p' "$side")
+  ref_seconds=$(sed -n 's/^ *"seconds": *\([0-9.e+-]*\).*/\1/p' "$side")
+  ref_est=$(sed -n 's/^ *"estimated_relmse": *\([0-9.e+-]*\).*/\1/p' "$side")
+  aggregate "$1" | awk -F '\t' -v ref_spp="$ref_spp" -v ref_seconds="$ref_seconds" -v ref_est="$ref_est" \
+      -v ref_strategy="$REF_STRATEGY" -v seeds="$SEEDS" '
+    {
+      s = $1
+      if (s == ref_strategy) own_spp = $3
+      if ($3 > max_spp) max_spp = $3
+      noise = $16
+      if ($2 == 1 && $5 > 0 && (best_r == "" || $5 < best_r)) { best_r = $5; best_rs = s }
+      if ($2 == 1 && $9 > best_e) { best_e = $9; best_es = s; best_ratio = $11; best_lo = $12; best_hi = $13; best_est = $8; best_m = $5 }
+      if (s == "cosine") { cm = $5; cest = $8 }
     }
     END {
-      printf "Most efficient unbiased strategy here: `%s`, %.3gx the efficiency of `cosine`. ", bs, (ce > 0 ? best / ce : 0)
-      printf "The film'"'"'s own estimate of relMSE (no reference) is %.2gx the measured value for `cosine` ", cest / cm
-      printf "and %.2gx for `%s`. ", best_est / bm, bs
-      printf "The reference'"'"'s own noise accounts for roughly %.0f%% of the measured relMSE of `%s` ", 100 * floor_relmse / rm, ref_strategy
-      printf "(its sample-variance estimate, scaled by the ratio of sample counts; less for noisier rows).\n"
-    }' "$1"
+      share = best_r > 0 ? noise / best_r : 0
+      printf "Reference: `pdflab reference`, `%s`, %d spp in %.0f s (%.0fx the spp of its own strategy'"'"'s run, %.0fx the most of any run); ", ref_strategy, ref_spp, ref_seconds, (own_spp > 0 ? ref_spp / own_spp : 0), (max_spp > 0 ? ref_spp / max_spp : 0)
+      printf "its own noise (relMSE %.3g) is **%.1f%%** of the best row'"'"'s relMSE (`%s`, %.4g)%s. ", noise, 100 * share, best_rs, best_r, (share <= 0.05 ? ", within the 5% this report aims at" : ", MORE than the 5% this report aims at: the ranking of the best rows is not settled")
+      printf "Most efficient unbiased strategy here: `%s`, %.3gx the efficiency of `cosine` (95%% interval %.3g to %.3g over %d seeds). ", best_es, best_ratio, best_lo, best_hi, seeds
+      printf "The film'"'"'s own estimate of relMSE (no reference) is %.2gx the measured value for `cosine` and %.2gx for `%s`.\n", (cm > 0 ? cest / cm : 0), (best_m > 0 ? best_est / best_m : 0), best_es
+    }'
 }
 
 {
@@ -165,16 +221,22 @@ summary() {
 # Convergence: what each sampling strategy buys per second
 
 Generated by \`scripts/convergence_report.sh\` (commit \`$commit\`, $run_date, $(nproc) cores,
-about $elapsed s). Each scene is rendered at ${SIZE}x$SIZE. The reference is \`$REF_STRATEGY\`
-(seed 1) at $(for s in "${SCENES[@]}"; do printf '%s spp for %s, ' "${REF_SPP_OF[$s]}" "$s"; done | sed 's/, $//');
-every strategy then renders for $BENCH_SECONDS s (equal time, seed 2) and is compared with it.
+$elapsed s in all) with \`SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS SEEDS=$SEEDS REF_SECONDS=$REF_SECONDS\`.
+Each scene is rendered at ${SIZE}x$SIZE. Its reference is made by \`pdflab reference\` (the default
+strategy, \`$REF_STRATEGY\`, seeds reserved for references) for $REF_SECONDS s; every strategy then
+renders for $BENCH_SECONDS s (equal time) with each of $SEEDS seeds (2 to $((SEEDS + 1))), and is compared with it.
 
-- relMSE = mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01); efficiency = 1 / (relMSE * seconds),
-  higher is better, and for an unbiased strategy it does not depend on how long it ran.
-- *est. relMSE* is what the render predicts about itself from its per-pixel sample variance, with no reference.
-- *vs cosine*: efficiency relative to cosine sampling, the book's starting point.
-- The reference has its own noise, which adds about (spp of a run / reference spp) of the reference
-  strategy's relMSE to every row: the best rows are slightly pessimistic.
+- relMSE = mean over pixels and channels of ((x - ref)^2 - var(ref)) / (ref^2 + 0.01): the error against
+  the true image, with the reference's own noise (its per-pixel variance of the mean) removed
+  ([measuring.md](measuring.md)); *raw relMSE* leaves it in. Means over the seeds, with 95% Student t
+  intervals over them.
+- efficiency = 1 / (relMSE * seconds), higher is better, and for an unbiased strategy it does not depend
+  on how long it ran. *vs cosine*: the ratio of efficiencies to cosine sampling (the book's starting
+  point), seed by seed, averaged, with its 95% interval.
+- *ref. share*: the reference's own noise as a part of the row's raw relMSE. Below each table: that noise
+  against the best row's relMSE, which the report keeps at 5% or less.
+- *est. relMSE* is what the render predicts about itself from its per-pixel sample variance, with no
+  reference: a lower bound.
 - A strategy marked **no** under *unbiased* (pure \`light\`) never sees indirect light: its error
   stops falling at the size of what it misses, so its efficiency is not comparable with the others.
 - Timings come from a machine shared with other work; ratios within one table are more trustworthy
@@ -190,14 +252,15 @@ EOF
 
 $(table "docs/convergence_$scene.csv")
 
-$(summary "docs/convergence_$scene.csv" "${REF_SPP_OF[$scene]}")
+$(summary "docs/convergence_$scene.csv" "docs/convergence_${scene}_reference.json")
 
-RMSE against time, log-log ([SVG](convergence_$scene.svg)); the dashed line has the slope of 1/sqrt(N):
+RMSE against time (seed 2), log-log ([SVG](convergence_$scene.svg)); the dashed line has the slope of 1/sqrt(N):
 
 ![RMSE against time for $scene](convergence_$scene.png)
 
-Raw numbers: [convergence_$scene.csv](convergence_$scene.csv), every checkpoint:
-[convergence_${scene}_curves.csv](convergence_${scene}_curves.csv).
+Raw numbers, every seed: [convergence_$scene.csv](convergence_$scene.csv); every checkpoint of seed 2:
+[convergence_${scene}_curves.csv](convergence_${scene}_curves.csv); the reference's sidecar:
+[convergence_${scene}_reference.json](convergence_${scene}_reference.json).
 
 EOF
   done
