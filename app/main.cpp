@@ -46,6 +46,12 @@ CLI::Validator positive_number(const std::string& what) {
       "NUMBER");
 }
 
+// Every command that reads or writes references takes the cache folder the same way.
+void add_cache_dir_option(CLI::App* command, std::string& cache_dir) {
+  command->add_option("--cache-dir", cache_dir,
+                      "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, else $XDG_CACHE_HOME/pdflab/references)");
+}
+
 CLI::Validator non_negative_integer() {
   return CLI::Validator(
       [](std::string& value) {
@@ -114,8 +120,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"gamma2", "srgb"}));
   render->add_option("--reference", ro.reference,
                      "Reference to measure against: a .pfm, or 'auto' for the cached one of this scene, size and depth");
-  render->add_option("--cache-dir", ro.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
-                                                  "else $XDG_CACHE_HOME/pdflab/references)");
+  add_cache_dir_option(render, ro.cache_dir);
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
 
   pdflab::ReferenceOptions fo;
@@ -136,8 +141,7 @@ int main(int argc, char** argv) {
   reference->add_option("--seed-stream", fo.seed_stream, "Which of the reference seeds (independent references)")
       ->check(CLI::Range(0u, 1u << 30));
   reference->add_option("--out", fo.out, "Also write the reference here (.pfm, with .var.pfm and .json beside it)");
-  reference->add_option("--cache-dir", fo.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
-                                                     "else $XDG_CACHE_HOME/pdflab/references)");
+  add_cache_dir_option(reference, fo.cache_dir);
   reference->add_option("--threads", fo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   reference->add_flag("--quiet", fo.quiet, "No progress bar or notes");
 
@@ -166,8 +170,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16384));
   bench->add_option("--height", bo.height, "With --reference auto: image height (default: the scene's)")
       ->check(CLI::Range(1, 16384));
-  bench->add_option("--cache-dir", bo.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
-                                                 "else $XDG_CACHE_HOME/pdflab/references)");
+  add_cache_dir_option(bench, bo.cache_dir);
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
   bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
@@ -192,8 +195,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16384));
   sweep->add_option("--height", so.height, "With --reference auto: image height (default: the scene's)")
       ->check(CLI::Range(1, 16384));
-  sweep->add_option("--cache-dir", so.cache_dir, "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, "
-                                                 "else $XDG_CACHE_HOME/pdflab/references)");
+  add_cache_dir_option(sweep, so.cache_dir);
   sweep->add_option("--seeds", so.seeds, "Runs per weight, for the intervals (default 3)")->check(CLI::Range(1, 1000));
   sweep->add_option("--seed", so.seed, "First seed (default 2; use one the reference was not rendered with)")
       ->check(non_negative_integer());

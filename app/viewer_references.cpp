@@ -33,9 +33,13 @@ bool ViewerReferences::follow_scene(const Scene& render_scene, ui::MeasureState&
     m.reference_note = "Loaded the cached reference for this scene at " + std::to_string(key.width) + "x" +
                        std::to_string(key.height) + ", depth " + std::to_string(key.max_depth) + ": " +
                        std::to_string(found.reference.info.spp) + " spp of " + found.reference.info.strategy + ".";
+    std::fprintf(stderr, "note: loaded the cached reference %s\n", found.path.c_str());  // for scripts
     return true;
   }
-  if (found.status == CacheLookup::Damaged) m.reference_error = found.message + "; Make reference rebuilds it.";
+  if (found.status == CacheLookup::Damaged) {
+    m.reference_error = found.message + "; Make reference rebuilds it.";
+    std::fprintf(stderr, "note: %s\n", found.message.c_str());
+  }
   if (m.reference.loaded() && m.reference_from_cache) {
     // Of another scene, size or depth: it would measure nothing.
     m.set_reference({});
@@ -129,6 +133,7 @@ bool ViewerReferences::service(ui::MeasureState& m) {
   std::snprintf(note, sizeof note, "Made a reference: %dx%d, %u spp of %s in %.0f s, stored in the cache.", w, h,
                 info.spp, info.strategy.c_str(), info.seconds);
   m.reference_note = note;
+  std::fprintf(stderr, "note: made a reference, stored as %s\n", done.path.c_str());
   return true;
 }
 

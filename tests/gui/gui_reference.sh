@@ -29,7 +29,7 @@ cached() { find "$PDFLAB_REFERENCE_CACHE" -name '*.json' 2>/dev/null | wc -l; }
 start_viewer() {
   # The last viewer's window must be gone, or the search below could find it.
   for _ in $(seq 50); do xdotool search --name '^pdflab' >/dev/null 2>&1 || break; sleep 0.1; done
-  "$pdflab" --scene "$scene" "$@" &
+  "$pdflab" --scene "$scene" "$@" 2>"$art/viewer_stderr.txt" &
   viewer=$!
   trap 'kill $viewer 2>/dev/null || true' EXIT
   wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
@@ -56,6 +56,8 @@ sleep 2
 shot measured
 changed "$art/panel_making.png" "$art/panel_measured.png" 0.005
 alive "$viewer" "Make reference"
+grep -q "note: made a reference, stored as $PDFLAB_REFERENCE_CACHE/" "$art/viewer_stderr.txt" ||
+  fail "the viewer did not report the reference it made"
 quit_viewer "$wid" "$viewer"
 trap - EXIT
 ls -l "$PDFLAB_REFERENCE_CACHE"
@@ -71,6 +73,8 @@ echo "== a second viewer loads it by itself"
 start_viewer --strategy cosine
 sleep 3
 shot autoloaded
+grep -q "note: loaded the cached reference $PDFLAB_REFERENCE_CACHE/" "$art/viewer_stderr.txt" ||
+  fail "the second viewer did not load the cached reference"
 quit_viewer "$wid" "$viewer"
 trap - EXIT
 
@@ -93,4 +97,13 @@ quit_viewer "$wid" "$viewer"
 trap - EXIT
 grep -h '"seed"' "$art"/shots/*.json
 grep -q '"seed": 2' "$art"/shots/*.json || fail "the viewer kept the reference's seed"
+echo "== a damaged cached reference: named and ignored, the viewer keeps running"
+for f in "$PDFLAB_REFERENCE_CACHE"/*.pfm; do head -c 100 "$f" >"$f.cut" && mv "$f.cut" "$f"; done
+start_viewer --strategy cosine
+sleep 3
+shot damaged
+alive "$viewer" "a damaged cached reference"
+grep -q "damaged and was ignored" "$art/viewer_stderr.txt" || fail "a damaged cached reference was not named"
+quit_viewer "$wid" "$viewer"
+trap - EXIT
 echo "PASS"
