@@ -28,6 +28,7 @@ class TeachingViews {
   bool on_key(int glfw_key, RenderSession& main, bool paused);
   // Esc: leaves probe mode, else closes the 1D lab. False when neither was on.
   bool on_escape();
+  void leave_probe_mode() { probe_.mode = false; }
   // Before drawing: keeps the split sessions in step with the main session
   // (which rests while the split renders) and collects their images.
   void update(RenderSession& main, bool paused);

@@ -7,6 +7,7 @@
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
+#include "ui/camera_control.h"
 #include "ui/display.h"
 #include "ui/image_view.h"
 #include "ui/measure_panel.h"
@@ -139,6 +140,9 @@ struct Viewer::Impl {
 
   // Looking closely: zoom and pan (framebuffer pixels), the pixel under the cursor.
   ui::ImageView view;
+  // Camera mode (O): the mouse moves the camera instead of the image.
+  bool camera_mode = false;
+  std::optional<Camera> camera;  // moved; none: the scene's own
   ui::Viewport last_area{};
   int pan_button = -1;  // the mouse button dragging the image, -1 none
   std::optional<ui::PixelReadout> inspected;
@@ -171,6 +175,11 @@ struct Viewer::Impl {
   void on_key(int key, int mods);
   void on_escape();
   void set_presentation(bool on);
+  void reset_camera() {
+    camera.reset();
+    apply_render_settings();
+  }
+  bool move_camera(const ui::Viewport& area, bool over);
   void navigate(const ui::Viewport& area, int framebuffer_height);
   void inspect(const ui::ImageRect& image_rect, const ui::ImageRect& area_rect);
   void request_quit();
@@ -399,6 +408,7 @@ bool Viewer::Impl::apply_render_settings() {
       render_scene_override != overridden ||
       (overridden && (render_scene->camera.width != settings.width_override ||
                       render_scene->camera.height != settings.height_override)) ||
+      !ui::same_placement(render_scene->camera, camera ? *camera : base_scene->camera) ||
       render_scene.get() == base_scene.get()) {
     auto scene = std::make_shared<Scene>(*base_scene);
     scene->max_depth = settings.max_depth;
@@ -411,6 +421,12 @@ bool Viewer::Impl::apply_render_settings() {
     if (overridden) {
       cam.width = settings.width_override;
       cam.height = settings.height_override;
+    }
+    if (camera) {
+      cam.lookfrom = camera->lookfrom;
+      cam.lookat = camera->lookat;
+      cam.vup = camera->vup;
+      cam.vfov_degrees = camera->vfov_degrees;
     }
     cam.prepare();
     render_scene = std::move(scene);
@@ -468,6 +484,8 @@ void Viewer::Impl::load_scene(const std::string& path) {
   auto previous_render = render_scene;
   const int previous_depth = settings.max_depth;
   const std::string previous_path = scene_path;
+  const std::optional<Camera> previous_camera = camera;
+  camera.reset();  // the new scene's own
   base_scene = std::make_shared<const Scene>(std::move(loaded));
   render_scene.reset();
   settings.max_depth = base_scene->max_depth;
@@ -479,6 +497,7 @@ void Viewer::Impl::load_scene(const std::string& path) {
     render_scene = previous_render;
     settings.max_depth = previous_depth;
     scene_path = previous_path;
+    camera = previous_camera;
     return;
   }
   status.scene_error.clear();
@@ -519,6 +538,10 @@ void Viewer::Impl::on_escape() {
     set_presentation(false);
     return;
   }
+  if (camera_mode) {
+    camera_mode = false;
+    return;
+  }
   if (teaching->on_escape()) return;
   if (panel.show_help) panel.show_help = false;
 }
@@ -545,6 +568,12 @@ void Viewer::Impl::on_key(int key, int mods) {
   const double cx = last_area.x + last_area.width * 0.5, cy = last_area.y + last_area.height * 0.5;
   switch (key) {
     case GLFW_KEY_F11: set_presentation(!settings.presentation); return;
+    case GLFW_KEY_O:
+      camera_mode = !camera_mode;
+      if (camera_mode) teaching->leave_probe_mode();  // one thing for a left drag to mean
+      return;
+    case GLFW_KEY_HOME: reset_camera(); return;
+    case GLFW_KEY_P: camera_mode = false; break;
     case GLFW_KEY_F: view.fit = true; return;
     case GLFW_KEY_Z: view.actual_size(last_area, w, h); return;
     case GLFW_KEY_EQUAL:
@@ -613,6 +642,10 @@ void Viewer::Impl::navigate(const ui::Viewport& area, int framebuffer_height) {
   const bool over = !io.WantCaptureMouse && mx >= area.x && mx < area.x + area.width && my >= area.y &&
                     my < area.y + area.height;
   const int w = image_info.width, h = image_info.height;
+  if (camera_mode) {
+    if (move_camera(area, over)) apply_render_settings();
+    return;
+  }
   if (over && io.MouseWheel != 0.0f) view.zoom_about(area, w, h, std::pow(1.25, io.MouseWheel), mx, my);
   if (pan_button >= 0 && !ImGui::IsMouseDown(pan_button)) pan_button = -1;
   if (pan_button < 0 && over) {
@@ -624,6 +657,28 @@ void Viewer::Impl::navigate(const ui::Viewport& area, int framebuffer_height) {
   // A left click that does not move is no pan (nothing else happens either).
   if (pan_button >= 0 && (pan_button != ImGuiMouseButton_Left || ImGui::IsMouseDragging(pan_button)))
     view.pan(area, w, h, io.MouseDelta.x * fbs, -io.MouseDelta.y * fbs);
+}
+
+bool Viewer::Impl::move_camera(const ui::Viewport& area, bool over) {
+  // Left drag orbits, right (or middle) drag pans, the wheel dollies.
+  const ImGuiIO& io = ImGui::GetIO();
+  if (pan_button >= 0 && !ImGui::IsMouseDown(pan_button)) pan_button = -1;
+  if (pan_button < 0 && over)
+    for (int b : {ImGuiMouseButton_Left, ImGuiMouseButton_Right, ImGuiMouseButton_Middle})
+      if (ImGui::IsMouseClicked(b)) pan_button = b;
+  const Camera now_at = camera ? *camera : base_scene->camera;
+  Camera moved = now_at;
+  const double fbs = framebuffer_scale;
+  const double dx = io.MouseDelta.x * fbs, dy = io.MouseDelta.y * fbs;
+  const double span = std::max(1, area.height);
+  if (pan_button == ImGuiMouseButton_Left && (dx != 0.0 || dy != 0.0))
+    moved = ui::orbit(moved, -dx / span * 3.0, dy / span * 3.0);
+  else if (pan_button > 0 && (dx != 0.0 || dy != 0.0))
+    moved = ui::pan(moved, -dx / span, dy / span);
+  if (over && io.MouseWheel != 0.0f) moved = ui::dolly(moved, std::pow(0.9, io.MouseWheel));
+  if (ui::same_placement(moved, now_at)) return false;
+  camera = moved;
+  return true;
 }
 
 void Viewer::Impl::inspect(const ui::ImageRect& image_rect, const ui::ImageRect& area_rect) {
@@ -681,6 +736,8 @@ ui::ScreenshotData Viewer::Impl::capture() const {
   d.max_depth = applied.max_depth;
   d.version = PDFLAB_VERSION;
   d.generation = image_info.generation;
+  if (render_scene) d.camera = render_scene->camera;
+  d.camera_moved = camera.has_value();
   return d;
 }
 
@@ -749,6 +806,8 @@ void Viewer::Impl::fill_status() {
   status.shown_spp = image_info.spp;
   status.screenshot_pending = screenshot_wanted || save_job.valid();
   status.can_retry_screenshot = failed_save.has_value() && !save_job.valid();
+  status.camera_mode = camera_mode;
+  status.camera_moved = camera.has_value();
   status.now = now();
   status.frame_ms = report.work_ms;
   status.measure = &measure;
@@ -877,6 +936,7 @@ bool Viewer::frame(bool paced, bool force_draw) {
   } else if (v.now() - v.presentation_since < 3.0) {
     ui::draw_hint("Presentation mode: F11 or Esc leaves");
   }
+  if (v.camera_mode) ui::draw_hint("Camera: drag orbits, right-drag pans, wheel dollies; Home resets, O or Esc leaves");
   ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
   if (!v.status.notice.text.empty() && v.now() - v.status.notice.shown_at < 6.0)
     ui::draw_notice_toast(v.status.notice, area_rect.width, area_rect.height);
@@ -907,6 +967,11 @@ bool Viewer::frame(bool paced, bool force_draw) {
   }
   if (requests.screenshot) v.screenshot_wanted = true;
   if (requests.toggle_presentation) v.set_presentation(!v.settings.presentation);
+  if (requests.toggle_camera_mode) {
+    v.camera_mode = !v.camera_mode;
+    if (v.camera_mode) v.teaching->leave_probe_mode();
+  }
+  if (requests.reset_camera) v.reset_camera();
   v.handle_measure_requests(requests.measure);
   if (requests.retry_screenshot && v.failed_save) {
     ui::ScreenshotData data = std::move(*v.failed_save);

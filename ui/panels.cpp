@@ -208,6 +208,12 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
   }
   ImGui::SameLine();
   if (ImGui::Button("Restart (R)")) requests.restart_render = true;
+  if (ImGui::Button(status.camera_mode ? "Leave camera mode (O)" : "Camera mode (O)")) requests.toggle_camera_mode = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Drag orbits, right-drag pans, the wheel dollies");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!status.camera_moved);
+  if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;
+  ImGui::EndDisabled();
 }
 
 void display_section(ViewerSettings& settings, UiRequests& requests) {
@@ -389,6 +395,8 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"Z, F", "one image pixel per screen pixel; fit the window"},
         {"Ctrl+C", "copy the pixel inspector's values"},
         {"F11", "presentation mode: full screen, the image alone"},
+        {"O", "camera mode: drag orbits, right-drag pans, wheel dollies"},
+        {"Home", "back to the scene's camera"},
         {"H, F1", "this help"},
         {"Esc", "close a drop-down, cancel an edit, leave probe mode"},
         {"Ctrl+Q", "quit (asks first when a render is unsaved)"},

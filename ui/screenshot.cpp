@@ -54,6 +54,12 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
   j["seconds"] = d.seconds;
   j["seed"] = d.seed;
   j["max_depth"] = d.max_depth;
+  const auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  j["camera"] = {{"lookfrom", vec(d.camera.lookfrom)},
+                 {"lookat", vec(d.camera.lookat)},
+                 {"vup", vec(d.camera.vup)},
+                 {"vfov", d.camera.vfov_degrees},
+                 {"moved", d.camera_moved}};
   j["exposure_ev"] = d.exposure_ev;
   j["transfer"] = d.transfer == Transfer::Gamma2 ? "gamma2" : "srgb";
   j["png"] = fs::path(paths.png).filename().string();

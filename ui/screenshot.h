@@ -4,6 +4,7 @@
 // was made. No UI code, so tests and the --screenshot mode share it.
 #include "renderer/film/image_io.h"
 #include "renderer/sampling/strategy.h"
+#include "renderer/scene/scene.h"
 
 #include <cstdint>
 #include <ctime>
@@ -26,6 +27,8 @@ struct ScreenshotData {
   int max_depth = 0;
   std::string version;
   std::uint64_t generation = 0;  // not in the sidecar: which render the viewer saved
+  Camera camera;                 // as rendered
+  bool camera_moved = false;     // moved in the viewer, not the scene file's
 };
 
 struct SavedScreenshot {

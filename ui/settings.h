@@ -83,6 +83,8 @@ struct UiRequests {
   bool screenshot = false;
   bool retry_screenshot = false;
   bool toggle_presentation = false;
+  bool toggle_camera_mode = false;
+  bool reset_camera = false;
   std::string load_scene;  // non-empty: try this file
   MeasureRequests measure;
 };
@@ -108,6 +110,8 @@ struct UiStatus {
   std::uint32_t shown_spp = 0;
   bool screenshot_pending = false;  // waiting for a full pass or for the writer
   bool can_retry_screenshot = false;
+  bool camera_mode = false;
+  bool camera_moved = false;  // not the scene's own camera
   Notice notice;
   double now = 0.0;
   double frame_ms = 0.0;

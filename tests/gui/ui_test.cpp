@@ -1,6 +1,7 @@
 // The viewer's plain-data parts: settings <-> strategies, presets, screenshot
 // names and failures, image placement. No window needed.
 #include "renderer/error.h"
+#include "ui/camera_control.h"
 #include "ui/display.h"
 #include "ui/image_view.h"
 #include "ui/screenshot.h"
@@ -150,6 +151,35 @@ TEST(SamplingSettings, TheWSliderPairIsTheTwoTechniquesInUseAndSurvivesZero) {
   EXPECT_EQ(ui::two_technique_pair(s, {cos, light}), (std::array<int, 2>{-1, -1}));
   EXPECT_EQ(ui::two_technique_pair(ui::SamplingSettings::from(Strategy::nee()), {cos, light}),
             (std::array<int, 2>{-1, -1}));
+}
+
+TEST(CameraControl, OrbitKeepsTheDistanceDollyAndPanMoveAsAsked) {
+  const Camera c{};  // the default: 800 in front of the box, looking at its centre
+  const float r = glm::length(c.lookfrom - c.lookat);
+  const Camera o = ui::orbit(c, 0.3, 0.2);
+  EXPECT_EQ(o.lookat, c.lookat);
+  EXPECT_NEAR(glm::length(o.lookfrom - o.lookat), r, 1e-3f * r);
+  EXPECT_FALSE(ui::same_placement(o, c));
+  // Undone by the opposite turn (yaw, then pitch in reverse).
+  const Camera back = ui::orbit(ui::orbit(o, 0.0, -0.2), -0.3, 0.0);
+  EXPECT_NEAR(glm::length(back.lookfrom - c.lookfrom), 0.0f, 1e-2f);
+  // Never over the top: pitching far stays short of vup.
+  const Camera top = ui::orbit(c, 0.0, 10.0);
+  const glm::vec3 dir = glm::normalize(top.lookfrom - top.lookat);
+  EXPECT_LT(glm::dot(dir, c.vup), 1.0f);
+  EXPECT_GT(glm::dot(dir, c.vup), 0.99f);
+  // Dolly: the distance scales, the direction stays; never onto the point looked at.
+  const Camera near = ui::dolly(c, 0.5);
+  EXPECT_NEAR(glm::length(near.lookfrom - near.lookat), r * 0.5f, 1e-3f * r);
+  EXPECT_GT(glm::length(ui::dolly(c, 0.0).lookfrom - c.lookat), 0.0f);
+  EXPECT_GT(glm::length(ui::dolly(c, 1e-9).lookfrom - c.lookat), 0.0f);
+  // Pan: both move together, across the view (not along it).
+  const Camera p = ui::pan(c, 0.1, 0.0);
+  EXPECT_EQ(p.lookfrom - c.lookfrom, p.lookat - c.lookat);
+  const glm::vec3 shift = p.lookat - c.lookat;
+  EXPECT_NEAR(glm::dot(shift, glm::normalize(c.lookat - c.lookfrom)), 0.0f, 1e-2f);
+  // 0.1 of the view's height at the distance looked at.
+  EXPECT_NEAR(glm::length(shift), 0.1f * 2.0f * r * std::tan(c.vfov_degrees * 3.14159265f / 360.0f), 0.05f);
 }
 
 TEST(QuitGuard, UnsavedSecondsCountFromTheLastSaveOfTheSameRender) {
