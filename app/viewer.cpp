@@ -257,6 +257,8 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  // Presentation mode's full screen stays up when another window takes the focus.
+  glfwWindowHint(GLFW_AUTO_ICONIFY, GLFW_FALSE);
 
   float xs = 1.0f, ys = 1.0f;
   GLFWmonitor* monitor = glfwGetPrimaryMonitor();

@@ -24,10 +24,10 @@ size=$((area < HEIGHT ? area : HEIGHT))
 left=$(((area - size) / 2)) top=$(((HEIGHT - size) / 2))
 xdotool mousemove 5 5
 sleep "$seconds"
-# The glass sphere's rim: zoom in about it, the inspector reads the pixel under the cursor.
-mx=$((left + size * 36 / 100)) my=$((top + size * 70 / 100))
+# The glass sphere: zoom in about it, the inspector reads the pixel under the cursor.
+mx=$((left + size * 58 / 100)) my=$((top + size * 77 / 100))
 xdotool mousemove "$mx" "$my"
-for _ in $(seq 9); do xdotool click 4; sleep 0.05; done
+for _ in $(seq 4); do xdotool click 4; sleep 0.05; done
 sleep 1
 import -window "$wid" "$root/docs/view_zoom.png"
 echo "wrote docs/view_zoom.png"

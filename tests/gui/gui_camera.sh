@@ -27,11 +27,7 @@ save() {
 PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine --spp 16 &
 viewer=$!
 trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-sleep 1
-xdotool windowfocus --sync "$wid"
-eval "$(xdotool getwindowgeometry --shell "$wid")"
+focus_window
 cx=$(((WIDTH - 400) / 2)) cy=$((HEIGHT / 2))
 sleep 2
 first=$(save 1)

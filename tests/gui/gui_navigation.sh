@@ -23,11 +23,7 @@ shot() {
 PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine &
 viewer=$!
 trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-sleep 1
-xdotool windowfocus --sync "$wid"
-eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
+focus_window
 "$pdflab" render --scene "$scene" --strategy cosine --spp 1 --out "$art/size.png" --quiet >/dev/null
 read -r iw ih <<<"$(identify -format '%w %h' "$art/size.png")"
 area=$((WIDTH - 400))

@@ -33,13 +33,9 @@ shot() {
 "$pdflab" --scene "$scene" --strategy cosine &
 viewer=$!
 trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-sleep 1
-xdotool windowfocus --sync "$wid"
+focus_window
 xdotool mousemove 2 2
 sleep 0.5
-eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
 px=$((WIDTH - 400))  # the side panel's left edge
 # The panel's top rows: the strategy drop-down, then (below what it covers
 # when open) the scene path field.

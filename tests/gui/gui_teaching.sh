@@ -10,7 +10,7 @@
 set -euo pipefail
 
 source "$(dirname "$0")/lib.sh"
-inside_xvfb "1400x900x24" "xdotool import identify compare" "$0" "$@"
+inside_xvfb "1400x900x24" "xdotool import identify compare convert" "$0" "$@"
 shift
 pdflab=$1 scene=$2 art=$3 docs=${4:-}
 rm -rf "$art"
@@ -37,12 +37,9 @@ shot() { import -window "$wid" "$art/$1.png"; }
 "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" &
 viewer=$!
 trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-xdotool windowfocus --sync "$wid"
+focus_window
 xdotool mousemove 2 2
 sleep 2
-eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
 shot base
 not_blank "$art/base.png"
 
@@ -104,11 +101,22 @@ shot lab_later
 changed "$art/lab.png" "$art/lab_later.png"
 
 echo "== 1D lab: f(x) typed as an expression"
+# Ctrl held across frames, then A: the field's text selected, to be typed over.
+select_all() {
+  xdotool keydown --window "$wid" ctrl
+  sleep 0.15
+  xdotool key --window "$wid" a
+  sleep 0.15
+  xdotool keyup --window "$wid" ctrl
+  sleep 0.15
+}
+# red_line FILE: the fraction of red pixels in the line under the lab's first
+# row, where a refused expression is named.
+red_line() { convert "$1" -crop 680x16+14+64 +repage -fx "r > 0.8 && g < 0.55 ? 1 : 0" -format "%[fx:mean]" info:; }
 # The f(x) field, right of the drop-down in the lab's first row.
 xdotool mousemove 250 48 click 1
 sleep 0.2
-xdotool key --window "$wid" ctrl+a
-sleep 0.2
+select_all
 xdotool type --window "$wid" "sin(pi*"
 xdotool key --window "$wid" Return
 xdotool mousemove 2 2
@@ -116,10 +124,10 @@ sleep 1
 alive "$viewer" "a bad expression"
 shot lab_bad
 changed "$art/lab_later.png" "$art/lab_bad.png"
+awk -v r="$(red_line "$art/lab_bad.png")" 'BEGIN { exit !(r > 0.01) }' || fail "no message for a bad expression"
 xdotool mousemove 250 48 click 1
 sleep 0.2
-xdotool key --window "$wid" ctrl+a
-sleep 0.2
+select_all
 xdotool type --window "$wid" "sin(pi*x)^2"
 xdotool key --window "$wid" Return
 xdotool mousemove 2 2
@@ -127,6 +135,7 @@ sleep "$settle"
 shot lab_typed
 not_blank "$art/lab_typed.png"
 changed "$art/lab_bad.png" "$art/lab_typed.png"
+awk -v r="$(red_line "$art/lab_typed.png")" 'BEGIN { exit !(r < 0.001) }' || fail "sin(pi*x)^2 was refused"
 [ -n "$docs" ] && cp "$art/lab_typed.png" "$docs/view_lab1d.png"
 
 quit_viewer "$wid" "$viewer"

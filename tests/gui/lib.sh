@@ -31,3 +31,12 @@ quit_viewer() {
   if kill -0 "$2" 2>/dev/null; then xdotool key --window "$1" ctrl+q; fi
   wait "$2" || fail "viewer exited with status $?"
 }
+# focus_window: waits for the viewer's window, gives it the keyboard and sets
+# wid, WIDTH and HEIGHT.
+focus_window() {
+  wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
+  [ -n "$wid" ] || fail "no viewer window"
+  sleep 1
+  xdotool windowfocus --sync "$wid"
+  eval "$(xdotool getwindowgeometry --shell "$wid")"
+}
