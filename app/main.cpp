@@ -5,6 +5,7 @@
 #include "app/render_command.h"
 #include "app/sweep_command.h"
 #include "renderer/error.h"
+#include "renderer/film/film_file.h"
 
 #include <CLI/CLI.hpp>
 
@@ -76,11 +77,13 @@ int main(int argc, char** argv) {
   std::string view_scene, view_strategy = "mix:cosine=0.5,light=0.5", screenshot;
   std::uint32_t view_spp = 0;
   app.add_option("--scene", view_scene, "Scene file (default: the book's Cornell box)");
-  app.add_option("--strategy", view_strategy, "Sampling strategy (see README)");
+  CLI::Option* view_strategy_option = app.add_option("--strategy", view_strategy, "Sampling strategy (see README)");
   app.add_option("--spp", view_spp, "With --screenshot: samples per pixel to render before saving")
       ->check(CLI::Range(1u, 1u << 30));
   app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
-  std::string view_reference;
+  std::string view_reference, view_resume;
+  app.add_option("--resume", view_resume,
+                 "Continue a film file (from render --film-out or the viewer's Ctrl+S) with its scene and settings");
   float view_ui_scale = 1.0f;
   bool view_presentation = false;
   app.add_option("--ui-scale", view_ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
@@ -238,12 +241,20 @@ int main(int argc, char** argv) {
     vo.spp = view_spp;
     vo.screenshot = screenshot;
     vo.reference = view_reference;
+    vo.resume = view_resume;
+    if (!view_resume.empty()) {
+      // The film names its scene and strategy; given again, they must match it.
+      const pdflab::FilmFile film = pdflab::read_film_file(view_resume);
+      if (view_scene.empty()) vo.scene = film.info.scene_file;
+      if (view_strategy_option->count() == 0) vo.strategy = film.info.strategy;
+    }
     vo.ui_scale = view_ui_scale;
     vo.presentation = view_presentation;
     vo.make_reference_seconds = view_make_seconds;
     return pdflab::run_viewer(vo);
 #else
     // Built without the viewer: render the default scene headlessly instead.
+    (void)view_strategy_option;
     pdflab::RenderOptions fallback;
     fallback.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;
     fallback.strategy = view_strategy;

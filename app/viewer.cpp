@@ -6,6 +6,7 @@
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
+#include "renderer/film/film_file.h"
 #include "renderer/session/session.h"
 #include "ui/camera_control.h"
 #include "ui/display.h"
@@ -195,6 +196,9 @@ struct Viewer::Impl {
     settle_frames = 2;
   }
   void fill_status();
+  void continue_film(const std::string& path);
+  void save_film();
+  std::uint32_t film_first_sample = 0;  // of the accumulation shown (0 unless a film was continued)
   void load_reference(const std::string& path);
   void after_reference_changed();
   void service_references();
@@ -242,7 +246,75 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   teaching->set_shared_reference(&measure.reference);
   references = std::make_unique<ViewerReferences>();
   if (!apply_render_settings()) throw InputError(status.settings_error);
+  if (!o.resume.empty()) continue_film(o.resume);
   if (o.presentation && !cli_mode()) set_presentation(true);
+}
+
+// The film's settings are applied, then its accumulation replaces the empty
+// one: the viewer goes on where the saved render stopped. Bad input (another
+// scene or strategy, a damaged film) throws InputError before a frame is shown.
+void Viewer::Impl::continue_film(const std::string& path) {
+  FilmFile file = read_film_file(path);
+  const FilmInfo& f = file.info;
+  if (f.ranges.size() != 1)
+    throw InputError("--resume: film '" + path + "' is a merge of " + std::to_string(f.ranges.size()) +
+                     " renders; only one render's film can be continued");
+  if (f.strategy != settings.sampling.strategy().to_string())
+    throw InputError("--resume: film '" + path + "' was rendered with strategy '" + f.strategy + "', not '" +
+                     settings.sampling.strategy().to_string() + "'");
+  settings.seed = f.ranges.front().seed;
+  settings.max_depth = f.max_depth;
+  settings.width_override = f.width;
+  settings.height_override = f.height;
+  if (!apply_render_settings()) throw InputError(status.settings_error);
+  if (film_scene_hash(*render_scene) != f.scene_hash)
+    throw InputError("--resume: film '" + path + "' was rendered from another scene than '" + scene_path + "'");
+  if (applied.seed != f.ranges.front().seed)
+    throw InputError("--resume: film '" + path + "' has the reference's seed; load another reference");
+  RenderSettings rs = session->settings();
+  rs.first_sample = f.ranges.front().first;
+  const auto spp = static_cast<std::uint32_t>(f.spp());
+  if (rs.target_spp != 0 && rs.target_spp < spp) rs.target_spp = spp;
+  session->resume(rs, FilmStart{std::move(file.film), spp, f.dropped});
+  film_first_sample = rs.first_sample;
+}
+
+// Ctrl+S: the accumulation as a film file in the screenshot folder, to
+// continue later with `pdflab --resume FILE` (or merge with other renders).
+void Viewer::Impl::save_film() {
+  const bool was_paused = settings.paused;
+  session->set_paused(true);  // the film is read between two passes
+  const RenderSettings rs = session->settings();
+  const double seconds = session->stats().seconds;  // not inside read_film: it holds the session's lock
+  try {
+    std::error_code ec;
+    std::filesystem::create_directories(settings.screenshot_dir, ec);
+    char stamp[32];
+    const std::time_t t = std::time(nullptr);
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&t));
+    std::string saved;
+    session->read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+      if (spp == 0) throw InputError("no complete pass to save yet");
+      FilmInfo info;
+      info.scene_hash = film_scene_hash(*rs.scene);
+      info.scene_file = scene_path;
+      info.width = film.width();
+      info.height = film.height();
+      info.max_depth = rs.scene->max_depth;
+      info.strategy = rs.strategy.to_string();
+      info.ranges = {SampleRange{rs.seed, rs.first_sample, rs.first_sample + spp}};
+      info.dropped = dropped;
+      info.seconds = seconds;
+      const std::string path = (std::filesystem::path(settings.screenshot_dir) /
+                                ("pdflab-" + std::string(stamp) + "-" + std::to_string(spp) + "spp.film")).string();
+      write_film_file(path, info, film);
+      saved = path;
+    });
+    notice("Film saved: " + std::filesystem::absolute(saved).string() + " (continue with pdflab --resume)", false);
+  } catch (const std::exception& e) {
+    notice(std::string("Film not saved: ") + e.what(), true);
+  }
+  if (!was_paused) session->set_paused(false);
 }
 
 void Viewer::Impl::open_window(int image_width, int image_height) {
@@ -561,6 +633,10 @@ void Viewer::Impl::on_key(int key, int mods) {
   if (quit_asking) return;
   // Typing a path must not pause the render or restart it.
   if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12) return;
+  if (key == GLFW_KEY_S && (mods & GLFW_MOD_CONTROL)) {
+    save_film();
+    return;
+  }
   if (key == GLFW_KEY_C && (mods & GLFW_MOD_CONTROL)) {
     // What the inspector shows, as text: for notes, and for tests to compare with the PFM.
     if (inspected) glfwSetClipboardString(window, inspected->text().c_str());

@@ -20,6 +20,9 @@ struct ViewerOptions {
   float ui_scale = 1.0f;  // panels and text, times the screen's own scale (0.5..4)
   bool presentation = false;  // start full screen without the panel
   double make_reference_seconds = 0.0;  // the Make reference time's first value (0: 30 s)
+  // A film file (film_file.h) to continue: its strategy, seed, size and depth
+  // are applied and its accumulation goes on (scene and strategy must match it).
+  std::string resume;
 };
 
 // Runs the viewer until the window closes. Returns the process exit status;

@@ -102,7 +102,11 @@ void write_exr(const std::string& path, const std::vector<float>& rgb, int width
   write_strips(path, header, height, frame, [](int, int) {});
 }
 
-std::vector<float> read_exr(const std::string& path, int& width, int& height) {
+namespace {
+
+// Three float channels of an EXR as interleaved RGB; empty when the file has
+// none of them.
+std::vector<float> read_exr_channels(const std::string& path, const char* const (&names)[3], int& width, int& height) {
   try {
     Imf::InputFile in(path.c_str(), 1);
     const IMATH_NAMESPACE::Box2i dw = in.header().dataWindow();
@@ -111,13 +115,13 @@ std::vector<float> read_exr(const std::string& path, int& width, int& height) {
     if (const std::string problem = image_size_problem(w, h); !problem.empty())
       throw InputError("'" + path + "': " + problem);
     bool any = false;
-    for (const char* c : kMeanChannels) any = any || in.header().channels().findChannel(c) != nullptr;
-    if (!any) throw InputError("'" + path + "': an EXR image without R, G or B channels");
+    for (const char* c : names) any = any || in.header().channels().findChannel(c) != nullptr;
+    if (!any) return {};
     std::vector<float> rgb(3 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0.0f);
     Imf::FrameBuffer fb;
     for (int c = 0; c < 3; ++c)
-      fb.insert(kMeanChannels[c], Imf::Slice::Make(Imf::FLOAT, rgb.data() + c, dw, 3 * sizeof(float),
-                                                   3 * sizeof(float) * static_cast<std::size_t>(w)));
+      fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, rgb.data() + c, dw, 3 * sizeof(float),
+                                           3 * sizeof(float) * static_cast<std::size_t>(w)));
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
     width = static_cast<int>(w);
@@ -128,6 +132,19 @@ std::vector<float> read_exr(const std::string& path, int& width, int& height) {
   } catch (const std::exception& e) {
     throw InputError("cannot read EXR '" + path + "': " + e.what());
   }
+}
+
+}  // namespace
+
+std::vector<float> read_exr(const std::string& path, int& width, int& height) {
+  std::vector<float> rgb = read_exr_channels(path, kMeanChannels, width, height);
+  if (rgb.empty()) throw InputError("'" + path + "': an EXR image without R, G or B channels");
+  return rgb;
+}
+
+std::vector<float> read_exr_variance(const std::string& path) {
+  int w = 0, h = 0;
+  return read_exr_channels(path, kVarianceChannels, w, h);
 }
 
 std::string read_exr_attribute(const std::string& path, const std::string& name) {

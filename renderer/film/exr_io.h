@@ -27,6 +27,10 @@ void write_exr(const std::string& path, const std::vector<float>& rgb, int width
 // file and the library's reason for anything it cannot read.
 std::vector<float> read_exr(const std::string& path, int& width, int& height);
 
+// The variance.R, variance.G and variance.B layers (as write_exr(film) writes
+// them) as float RGB, or empty when the file has none of them.
+std::vector<float> read_exr_variance(const std::string& path);
+
 // The named string attribute of an EXR file, or empty when it has none.
 std::string read_exr_attribute(const std::string& path, const std::string& name);
 

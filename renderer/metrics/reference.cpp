@@ -1,7 +1,9 @@
 #include "renderer/metrics/reference.h"
 
 #include "renderer/error.h"
+#include "renderer/film/exr_io.h"
 #include "renderer/film/film.h"
+#include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
 #include "renderer/hash.h"
 #include "renderer/metrics/metrics.h"
@@ -10,7 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -155,7 +159,62 @@ void save_reference(const std::string& mean_path, const Reference& ref) {
   write_file_atomic(paths.sidecar, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
 }
 
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// A film file (film_file.h) as a reference: its mean and variance of the mean,
+// and what it records. A film of one seed says which; a merge of several
+// seeds leaves the seed unknown.
+Reference load_film_reference(const std::string& path) {
+  FilmFile file = read_film_file(path);  // InputError naming the file
+  const FilmInfo& f = file.info;
+  ReferenceInfo info;
+  info.has_sidecar = true;  // the film records what a sidecar would
+  info.scene_file = f.scene_file;
+  char hash[24];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(f.scene_hash));
+  info.scene_hash = hash;
+  info.max_depth = f.max_depth;
+  info.strategy = f.strategy;
+  info.seed_known = f.ranges.size() == 1;
+  if (info.seed_known) info.seed = f.ranges.front().seed;
+  info.spp = static_cast<std::uint32_t>(f.spp());
+  info.seconds = f.seconds;
+  Reference r = reference_from_film(file.film, std::move(info));
+  r.path = path;
+  return r;
+}
+
+// An EXR: R, G, B, and the variance layers when it has them (pdflab's EXRs do).
+Reference load_exr_reference(const std::string& path) {
+  Reference r;
+  r.path = path;
+  r.rgb = read_exr(path, r.width, r.height);  // InputError naming the file
+  check_values(path, r.rgb, r.width, false);
+  r.variance = read_exr_variance(path);
+  if (!r.variance.empty()) check_values(path, r.variance, r.width, true);
+  r.info.strategy = read_exr_attribute(path, "pdflab.strategy");
+  const std::string seed = read_exr_attribute(path, "pdflab.seed");
+  if (!seed.empty()) {
+    r.info.seed_known = true;
+    r.info.seed = std::strtoull(seed.c_str(), nullptr, 10);
+  }
+  r.info.spp = static_cast<std::uint32_t>(std::strtoul(read_exr_attribute(path, "pdflab.spp").c_str(), nullptr, 10));
+  r.info.has_sidecar = !r.info.strategy.empty();
+  return r;
+}
+
+}  // namespace
+
 Reference load_reference(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".film") return load_film_reference(path);
+  if (ext == ".exr") return load_exr_reference(path);
   const ReferencePaths paths = reference_paths(path);
   Reference r;
   r.path = path;
