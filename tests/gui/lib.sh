@@ -20,6 +20,10 @@ inside_xvfb() {
 
 fail() { echo "FAIL: $*"; exit 1; }
 
+# The viewer loads the cached reference of its scene by itself: the tests never
+# see the user's cache (a test that wants one sets its own folder).
+export PDFLAB_REFERENCE_CACHE="${PDFLAB_REFERENCE_CACHE:-$(mktemp -u -t pdflab-no-cache-XXXXXX)}"
+
 # alive PID WHAT: the viewer is still running after WHAT.
 alive() { kill -0 "$1" 2>/dev/null || fail "the viewer quit after $2"; }
 # quit_viewer WID PID: Ctrl+Q, and Ctrl+Q again ("quit anyway") when it asks
