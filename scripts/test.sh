@@ -40,7 +40,7 @@ phase_done "ASan+UBSan build and suite (without slow tests)"
 no_aslr=()
 if setarch "$(uname -m)" -R true 2>/dev/null; then no_aslr=(setarch "$(uname -m)" -R); fi
 cmake --preset tsan >/dev/null
-cmake --build --preset tsan -j"$jobs" --target test_session_soak session_viewer_test
+cmake --build --preset tsan -j"$jobs" --target test_session_soak session_viewer_test test_reference_build
 "${no_aslr[@]}" ctest --preset tsan -j"$jobs" --timeout 900 -L session
 phase_done "TSan build and session tests"
 
