@@ -87,8 +87,8 @@ int main(int argc, char** argv) {
 
     auto& w = viewer.settings().sampling;
     w.mixture = true;
-    w.weights[0] = 0.2f + 0.6f * static_cast<float>(t % 7) / 6.0f;  // cosine
-    w.weights[3] = 1.0f - w.weights[0];                            // light
+    w.weights[static_cast<int>(pdflab::Technique::Cosine)] = 0.2f + 0.6f * static_cast<float>(t % 7) / 6.0f;
+    w.weights[static_cast<int>(pdflab::Technique::Light)] = 1.0f - w.weights[static_cast<int>(pdflab::Technique::Cosine)];
     const auto changed = Clock::now();
     viewer.request_restart();
     const std::uint64_t generation = viewer.session_generation();

@@ -37,24 +37,6 @@ inline bool is_finite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 
-// sin and cos of 2 pi u for u in [0, 1], to about 3e-7: reduced to [-pi/4, pi/4]
-// around the nearest quarter turn, then short Taylor polynomials, then rotated
-// back without branches. Used to draw azimuths, where libm's sincosf (which
-// handles any argument) is a measurable part of a bounce.
-inline void sincos_2pi(float u, float& sin_out, float& cos_out) {
-  const int nearest = static_cast<int>(u * 4.0f + 0.5f);  // nearest quarter turn, 0..4 (u >= 0)
-  const float r = (u - static_cast<float>(nearest) * 0.25f) * (2.0f * std::numbers::pi_v<float>);  // |r| <= pi/4
-  const float r2 = r * r;
-  const float s = r * (1.0f + r2 * (-1.0f / 6.0f + r2 * (1.0f / 120.0f + r2 * (-1.0f / 5040.0f))));
-  const float c = 1.0f + r2 * (-0.5f + r2 * (1.0f / 24.0f + r2 * (-1.0f / 720.0f + r2 * (1.0f / 40320.0f))));
-  const int q = nearest & 3;
-  // Rotate (c, s) by q quarter turns.
-  const float cs[4] = {c, -s, -c, s};
-  const float sn[4] = {s, c, -s, -c};
-  cos_out = cs[q];
-  sin_out = sn[q];
-}
-
 struct Ray {
   Vec3 origin;
   Vec3 direction;  // unit length everywhere in the renderer

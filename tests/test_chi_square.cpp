@@ -564,7 +564,7 @@ TEST(ChiSquareHarness, RejectsSlightlyWrongLightPdf) {
   const Frame frame(n);
   auto sampler = [&](Rng& rng) {
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-    return plan.sample_light(origin, u0, u1, u2);
+    return plan.book_targets.sample(origin, u0, u1, u2);
   };
   auto density = [&](const Vec3& d) { return static_cast<double>(quad_area_pdf(shifted, origin, d)); };
   Scene shifted_scene = scene;

@@ -72,6 +72,18 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
     ImGui::EndCombo();
   }
 
+  // A slider for each parameter a technique in use takes (cosine-power's N).
+  for (int i = 0; i < kTechniqueCount && !s.nee_mis; ++i) {
+    const TechniqueInfo& t = technique_info(static_cast<Technique>(i));
+    const bool used = s.mixture ? s.weights[i] > 0.0f : s.single == static_cast<Technique>(i);
+    if (t.parameter.empty() || !used) continue;
+    ImGui::PushID(100 + i);
+    const std::string label = std::string(t.name) + " " + std::string(t.parameter);
+    ImGui::SliderFloat(label.c_str(), &s.parameters[i], t.parameter_min, t.parameter_max, "%.1f",
+                       ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
+    ImGui::PopID();
+  }
+
   if (s.nee_mis) draw_nee_explanation();
   if (s.mixture && !s.nee_mis) {
     // The book's two-technique mixture as one number: w * A + (1 - w) * B.

@@ -6,14 +6,15 @@ namespace pdflab::ui {
 
 Strategy SamplingSettings::strategy() const {
   if (nee_mis) return Strategy::nee(heuristic);
-  if (!mixture) return Strategy::single(single);
-  Strategy s;
-  s.weights = weights;
+  Strategy s = mixture ? Strategy{} : Strategy::single(single);
+  if (mixture) s.weights = weights;
+  s.parameters = parameters;
   return s;
 }
 
 SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   SamplingSettings out;
+  out.parameters = strategy.parameters;
   if (strategy.nee_mis) {
     out.nee_mis = true;
     out.heuristic = strategy.heuristic;

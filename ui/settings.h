@@ -20,6 +20,7 @@ struct SamplingSettings {
   bool mixture = true;
   Technique single = Technique::Cosine;
   std::array<float, kTechniqueCount> weights{};
+  std::array<float, kTechniqueCount> parameters = Strategy::default_parameters();  // `cosine-power:N`
   // Next-event estimation with MIS: its own mode, neither one technique nor a
   // mixture (two samples per vertex); overrides the two above while set.
   bool nee_mis = false;

@@ -1,5 +1,7 @@
 #include "ui/teach_draw.h"
 
+#include "renderer/sampling/strategy.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -89,14 +91,9 @@ ImU32 colormap(float t) {
 }
 
 ImU32 technique_colour(int technique) {
-  switch (technique) {
-    case 0: return IM_COL32(90, 170, 255, 255);   // cosine
-    case 1: return IM_COL32(120, 220, 120, 255);  // uniform hemisphere
-    case 2: return IM_COL32(200, 140, 255, 255);  // uniform sphere
-    case 3: return IM_COL32(255, 190, 60, 255);   // light
-    case 4: return IM_COL32(255, 100, 80, 255);   // light solid angle
-    default: return IM_COL32(150, 150, 150, 255);
-  }
+  if (technique < 0 || technique >= kTechniqueCount) return IM_COL32(150, 150, 150, 255);  // no direction
+  const auto& c = technique_info(static_cast<Technique>(technique)).colour;
+  return IM_COL32(c[0], c[1], c[2], 255);
 }
 
 namespace {

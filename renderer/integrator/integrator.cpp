@@ -13,47 +13,23 @@ std::string_view drop_reason_name(DropReason r) {
 
 namespace {
 
-inline Vec3 reflect(const Vec3& v, const Vec3& n) { return v - n * (2.0f * dot(v, n)); }
-
-inline Vec3 random_unit_vector(Rng& rng) {
-  const float u1 = rng.uniform();
-  const float u2 = rng.uniform();
-  return sample_uniform_sphere(u1, u2).direction;
-}
-
-// Schlick's approximation to the Fresnel reflectance.
-inline float schlick(float cosine, float eta_ratio) {
-  float r0 = (1.0f - eta_ratio) / (1.0f + eta_ratio);
-  r0 *= r0;
-  const float m = 1.0f - cosine;
-  const float m2 = m * m;
-  return r0 + (1.0f - r0) * m2 * m2 * m;
-}
-
 // Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
-// ray); returns false when the path ends (absorbed).
+// ray); returns false when the path ends (absorbed). The scatter rules are
+// leaf math (metal_direction, dielectric_setup / dielectric_direction).
 bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
                       Vec3& throughput, Rng& rng) {
+  Vec3 dir;
   if (m.type == MaterialType::Metal) {
-    Vec3 dir = reflect(ray.direction, normal);
-    if (m.fuzz > 0.0f) dir = normalize(dir + random_unit_vector(rng) * m.fuzz);
+    const bool fuzzy = m.fuzz > 0.0f;
+    float u1 = 0.0f, u2 = 0.0f;
+    if (fuzzy) u1 = rng.uniform(), u2 = rng.uniform();
+    dir = leaf::metal_direction(ray.direction, normal, m.fuzz, fuzzy, u1, u2);
     if (dot(dir, normal) <= 0.0f) return false;  // fuzz pushed it under the surface: absorbed
     throughput *= m.albedo;
-    ray = spawn_ray(hit.point, hit.normal, dir);
-    return true;
-  }
-  // Dielectric: Schlick reflectance, total internal reflection.
-  const float eta_ratio = front_face ? 1.0f / m.ior : m.ior;
-  const float cos_theta = min_of(-dot(ray.direction, normal), 1.0f);
-  const float sin2_theta = positive_part(1.0f - cos_theta * cos_theta);
-  const float sin2_t = eta_ratio * eta_ratio * sin2_theta;
-  Vec3 dir;
-  if (sin2_t > 1.0f || schlick(cos_theta, eta_ratio) > rng.uniform()) {
-    dir = reflect(ray.direction, normal);
   } else {
-    const Vec3 perp = (ray.direction + normal * cos_theta) * eta_ratio;
-    const Vec3 parallel = normal * -std::sqrt(positive_part(1.0f - sin2_t));
-    dir = normalize(perp + parallel);
+    const leaf::Refraction r = leaf::dielectric_setup(ray.direction, normal, front_face, m.ior);
+    const bool reflects = r.total_internal || r.reflectance > rng.uniform();
+    dir = leaf::dielectric_direction(r, ray.direction, normal, reflects);
   }
   ray = spawn_ray(hit.point, hit.normal, dir);
   return true;
@@ -112,9 +88,8 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
         if (cosine > 0.0f && intersect(scene, spawn_ray(hit.point, hit.normal, ls.direction), kInf, shadow_hit)) {
           const Material& lm = scene.materials[shadow_hit.material];
           if (lm.type == MaterialType::DiffuseLight && (dot(ls.direction, shadow_hit.normal) < 0.0f || lm.two_sided)) {
-            const float bsdf_pdf = cosine * kInvPi;
-            const float w = mis_weight(ls.pdf, bsdf_pdf, plan.heuristic);
-            radiance += throughput * m.albedo * lm.emit * (bsdf_pdf * w / ls.pdf);
+            const float bsdf_pdf = leaf::cosine_hemisphere_density(cosine);
+            radiance += throughput * m.albedo * lm.emit * leaf::light_sample_weight(bsdf_pdf, ls.pdf, plan.heuristic);
           }
         }
       }
@@ -170,7 +145,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       }
       const float cosine = dot(ds.direction, normal);
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
-      throughput *= m.albedo * (cosine * kInvPi / ds.pdf);
+      throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
       ray = spawn_ray(hit.point, hit.normal, ds.direction);
     } else if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) {
       break;

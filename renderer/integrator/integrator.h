@@ -48,16 +48,6 @@ inline std::uint8_t drop_reason_bits(const DropCounts& before, const DropCounts&
 // Radiance along one camera ray. Returns zero (and counts) when the estimate is not finite.
 Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops);
 
-// Weight of technique `a` against `b` for a sample both could have drawn.
-inline float mis_weight(float a, float b, MisHeuristic h) {
-  if (h == MisHeuristic::Power) {
-    a *= a;
-    b *= b;
-  }
-  if (a == kInf) return 1.0f;  // also keeps inf/inf from becoming NaN
-  return a / (a + b);
-}
-
 // The camera ray and the random stream of one pixel sample.
 struct PixelSampleStart {
   Ray ray;

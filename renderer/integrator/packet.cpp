@@ -88,6 +88,31 @@ void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, st
   packet_generic::trace_block_impl(scene, plan, seed, block, out);
 }
 
+void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out) {
+#if PDFLAB_PACKET_DISPATCH
+  if (isa == PacketIsa::Avx2) {
+    packet_avx2::sample_plan_impl(plan, draws, n, out);
+    return;
+  }
+#else
+  (void)isa;
+#endif
+  packet_generic::sample_plan_impl(plan, draws, n, out);
+}
+
+void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,
+              float* out) {
+#if PDFLAB_PACKET_DISPATCH
+  if (isa == PacketIsa::Avx2) {
+    packet_avx2::plan_pdf_impl(plan, draws, directions, n, out);
+    return;
+  }
+#else
+  (void)isa;
+#endif
+  packet_generic::plan_pdf_impl(plan, draws, directions, n, out);
+}
+
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
                  SampleResult* out) {
   trace_block(best_packet_isa(), scene, plan, seed, block, out);

@@ -50,4 +50,18 @@ void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t see
 void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
                  const SampleBlock& block, SampleResult* out);
 
+// The sampling plan's draw at diffuse shading points, `packet_lanes` at a
+// time through the very code the packet tracer renders with (for the
+// chi-square suite and the tests that compare it with the one-path draw).
+// Each draw gives its random numbers: u0 picks the technique, u1 and u2 the
+// direction, u_choice the target (used only by the techniques that draw one).
+struct PlanDraw {
+  Vec3 point, normal;  // normal faces the incoming ray
+  float u0, u1, u2, u_choice;
+};
+void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out);
+// The mixture's density for `directions[i]` at draws[i]'s point (its random numbers unused).
+void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,
+              float* out);
+
 }  // namespace pdflab

@@ -1,5 +1,7 @@
 #include "renderer/sampling/strategy.h"
 
+#include "renderer/sampling/mixture.h"
+
 #include "renderer/error.h"
 
 #include <charconv>
@@ -10,8 +12,11 @@ namespace pdflab {
 
 namespace {
 
-constexpr std::array<std::string_view, kTechniqueCount> kNames = {
-    "cosine", "uniform-hemisphere", "uniform-sphere", "light", "light-sa"};
+constexpr std::array<TechniqueInfo, kTechniqueCount> kTable = {
+#define PDFLAB_ROW(T) leaf::T::info,
+    PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
+};
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -21,16 +26,49 @@ std::string_view trim(std::string_view s) {
 
 std::string known_list() {
   std::string out;
-  for (auto n : kNames) {
+  for (const TechniqueInfo& t : kTable) {
     if (!out.empty()) out += ", ";
-    out.append(n);
+    out.append(t.name);
+    if (!t.parameter.empty()) out.append("[:").append(t.parameter).append("]");
   }
   return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance";
 }
 
-Technique parse_technique(std::string_view name, std::string_view whole) {
-  for (int i = 0; i < kTechniqueCount; ++i)
-    if (kNames[i] == name) return static_cast<Technique>(i);
+std::string format_number(float x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(x));
+  return buf;
+}
+
+float parse_parameter(const TechniqueInfo& t, std::string_view text, std::string_view whole) {
+  float value = 0.0f;
+  const auto* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || !(value >= t.parameter_min && value <= t.parameter_max))
+    throw InputError("strategy '" + std::string(whole) + "': " + std::string(t.name) + "'s " +
+                     std::string(t.parameter) + " '" + std::string(text) + "' is not a number in [" +
+                     format_number(t.parameter_min) + ", " + format_number(t.parameter_max) + "]");
+  return value;
+}
+
+struct ParsedTechnique {
+  Technique technique;
+  float parameter;
+};
+
+// NAME or NAME:PARAMETER, for a technique whose row has a parameter.
+ParsedTechnique parse_technique(std::string_view text, std::string_view whole) {
+  const size_t colon = text.find(':');
+  const std::string_view name = text.substr(0, colon);
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const TechniqueInfo& t = kTable[i];
+    if (t.name != name) continue;
+    if (colon == std::string_view::npos) return {static_cast<Technique>(i), t.parameter_default};
+    if (t.parameter.empty())
+      throw InputError("strategy '" + std::string(whole) + "': technique '" + std::string(name) +
+                       "' takes no parameter");
+    return {static_cast<Technique>(i), parse_parameter(t, text.substr(colon + 1), whole)};
+  }
   if (name.substr(0, 7) == "nee-mis")
     throw InputError("strategy '" + std::string(whole) + "': nee-mis is a strategy of its own and cannot be mixed");
   throw InputError("unknown strategy '" + std::string(whole) + "'" +
@@ -52,7 +90,14 @@ float parse_weight(std::string_view text, std::string_view whole) {
 
 }  // namespace
 
-std::string_view technique_name(Technique t) { return kNames[static_cast<int>(t)]; }
+const TechniqueInfo& technique_info(Technique t) { return kTable[static_cast<int>(t)]; }
+std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)].name; }
+
+std::array<float, kTechniqueCount> Strategy::default_parameters() {
+  std::array<float, kTechniqueCount> p{};
+  for (int i = 0; i < kTechniqueCount; ++i) p[i] = kTable[i].parameter_default;
+  return p;
+}
 
 Strategy Strategy::single(Technique t) {
   Strategy s;
@@ -75,7 +120,12 @@ Strategy Strategy::parse(std::string_view text) {
   if (whole.substr(0, 8) == "nee-mis:")
     throw InputError("strategy '" + std::string(whole) + "': the heuristic must be 'power' or 'balance'");
   constexpr std::string_view kMix = "mix:";
-  if (whole.substr(0, kMix.size()) != kMix) return single(parse_technique(whole, whole));
+  if (whole.substr(0, kMix.size()) != kMix) {
+    const ParsedTechnique p = parse_technique(whole, whole);
+    Strategy s = single(p.technique);
+    s.parameters[static_cast<int>(p.technique)] = p.parameter;
+    return s;
+  }
 
   Strategy s;
   std::array<bool, kTechniqueCount> seen{};
@@ -88,8 +138,10 @@ Strategy Strategy::parse(std::string_view text) {
     if (eq == std::string_view::npos)
       throw InputError("strategy '" + std::string(whole) + "': term '" + std::string(term) +
                        "' is not TECHNIQUE=WEIGHT");
-    const Technique t = parse_technique(trim(term.substr(0, eq)), whole);
+    const ParsedTechnique p = parse_technique(trim(term.substr(0, eq)), whole);
+    const Technique t = p.technique;
     const int i = static_cast<int>(t);
+    s.parameters[i] = p.parameter;
     if (seen[i])
       throw InputError("strategy '" + std::string(whole) + "': technique '" +
                        std::string(technique_name(t)) + "' appears twice");
@@ -111,7 +163,13 @@ std::string Strategy::to_string() const {
     if (weights[i] > 0.0f) ++used, last = i;
   double total = 0.0;  // in double: weights near FLT_MAX would overflow a float sum
   for (float w : weights) total += w;
-  if (used == 1) return std::string(kNames[last]);
+  // NAME, or NAME:PARAMETER for a technique with one.
+  auto spelled = [&](int i) {
+    std::string name(kTable[i].name);
+    if (!kTable[i].parameter.empty()) name.append(":").append(format_number(parameters[i]));
+    return name;
+  };
+  if (used == 1) return spelled(last);
   std::string out = "mix:";
   bool first = true;
   for (int i = 0; i < kTechniqueCount; ++i) {
@@ -119,14 +177,17 @@ std::string Strategy::to_string() const {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(weights[i]) / total);
     if (!first) out += ',';
-    out.append(kNames[i]).append("=").append(buf);
+    out.append(spelled(i)).append("=").append(buf);
     first = false;
   }
   return out;
 }
 
 bool Strategy::is_unbiased() const {
-  return nee_mis || uses(Technique::Cosine) || uses(Technique::UniformHemisphere) || uses(Technique::UniformSphere);
+  if (nee_mis) return true;
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (kTable[i].covers_hemisphere && uses(static_cast<Technique>(i))) return true;
+  return false;
 }
 
 double emitter_power(const Material& m, double area) {
@@ -260,16 +321,17 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   if (strategy.nee_mis) {
     plan.weight[static_cast<int>(Technique::Cosine)] = 1.0f;  // the material sample
     plan.cdf.fill(1.0f);
+    plan.uses_frame = true;
     return plan;
   }
 
+  plan.parameter = strategy.parameters;
   std::array<float, kTechniqueCount> w = strategy.weights;
-  // A light technique with nothing to aim at has no distribution: its weight
-  // goes to the other techniques (renormalised below).
-  if (plan.target_count == 0) {
-    w[static_cast<int>(Technique::Light)] = 0.0f;
-    w[static_cast<int>(Technique::LightSolidAngle)] = 0.0f;
-  }
+  // A technique that aims at targets has nothing to aim at: its weight goes to
+  // the other techniques (renormalised below).
+  if (plan.target_count == 0)
+    for (int i = 0; i < kTechniqueCount; ++i)
+      if (kTable[i].draws_target) w[i] = 0.0f;
   double total = 0.0;
   for (float x : w) total += x;
   if (!(total > 0.0))
@@ -283,6 +345,10 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
     plan.cdf[i] = static_cast<float>(running);
     if (w[i] > 0.0f) last_positive = i;
   }
+#define PDFLAB_ROW(T) \
+  plan.uses_frame = plan.uses_frame || (leaf::uses_frame<leaf::T>() && plan.weight[static_cast<int>(Technique::T)] > 0.0f);
+  PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
   // u < cdf[last_positive] must hold for every u in [0, 1); techniques after it
   // have weight zero and must never be chosen.
   for (int i = last_positive; i < kTechniqueCount; ++i) plan.cdf[i] = 1.0f;
@@ -290,49 +356,17 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
 }
 
 float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const {
-  float p = 0.0f;
-  if (weight[0] > 0.0f) p += weight[0] * cosine_hemisphere_pdf(normal, direction);
-  if (weight[1] > 0.0f) p += weight[1] * uniform_hemisphere_pdf(normal, direction);
-  if (weight[2] > 0.0f) p += weight[2] * uniform_sphere_pdf();
-  if (weight[3] > 0.0f) p += weight[3] * book_targets.pdf(origin, direction);
-  if (weight[4] > 0.0f) p += weight[4] * power_targets.pdf(origin, direction);
-  return p;
+  return leaf::mixture_pdf(*this, leaf::Shading(*this, origin, normal, 0.0f, 0.0f, 0.0f), direction, true);
 }
 
 DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
   const float u0 = rng.uniform();
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
-  int chosen = 0;
-  while (u0 >= cdf[chosen]) ++chosen;
+  const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
-
-  DirectionSample ds;
-  switch (static_cast<Technique>(chosen)) {
-    case Technique::Cosine: ds = sample_cosine_hemisphere(Onb(normal), u1, u2); break;
-    case Technique::UniformHemisphere: ds = sample_uniform_hemisphere(Onb(normal), u1, u2); break;
-    case Technique::UniformSphere: ds = sample_uniform_sphere(u1, u2); break;
-    case Technique::Light: ds = book_targets.sample(origin, rng.uniform(), u1, u2); break;
-    default: ds = power_targets.sample(origin, rng.uniform(), u1, u2); break;
-  }
-  if (ds.none || weight[chosen] == 1.0f) return ds;  // a single technique: its own pdf is the mixture's
-
-  // One-sample mixture: the density of the direction under every technique.
-  // The hemisphere terms are cheap and branch-free (a zero weight adds zero).
-  // The chosen technique keeps its sampler's own value, so a direction that
-  // rounding puts exactly on the horizon cannot get a zero mixture pdf.
-  const float c = dot(normal, ds.direction);
-  const float above = c > 0.0f ? 1.0f : 0.0f;
-  constexpr int light = static_cast<int>(Technique::Light), light_sa = static_cast<int>(Technique::LightSolidAngle);
-  const float light_term =
-      chosen == light ? ds.pdf : (weight[light] > 0.0f ? book_targets.pdf(origin, ds.direction) : 0.0f);
-  const float light_sa_term =
-      chosen == light_sa ? ds.pdf : (weight[light_sa] > 0.0f ? power_targets.pdf(origin, ds.direction) : 0.0f);
-  ds.pdf = weight[0] * (chosen == 0 ? ds.pdf : above * c * kInvPi) +
-           weight[1] * (chosen == 1 ? ds.pdf : above * kInv2Pi) +
-           weight[2] * (chosen == 2 ? ds.pdf : kInv4Pi) + weight[light] * light_term +
-           weight[light_sa] * light_sa_term;
-  return ds;
+  const float u_choice = leaf::draws_target(chosen) ? rng.uniform() : 0.0f;
+  return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
 }
 
 }  // namespace pdflab

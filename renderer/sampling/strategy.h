@@ -4,6 +4,7 @@
 // A small value decided once per pass; nothing here allocates per ray.
 #include "renderer/math.h"
 #include "renderer/sampling/rng.h"
+#include "renderer/sampling/technique_table.h"
 #include "renderer/sampling/techniques.h"
 #include "renderer/scene/scene.h"
 
@@ -14,38 +15,32 @@
 
 namespace pdflab {
 
-enum class Technique : std::uint8_t {
-  Cosine,
-  UniformHemisphere,
-  UniformSphere,
-  Light,            // the book's: targets chosen uniformly, quads by area, spheres by cone
-  LightSolidAngle,  // targets chosen by power, quads by spherical rectangle, spheres by cone
-  Count
-};
-inline constexpr int kTechniqueCount = static_cast<int>(Technique::Count);
-
+// The technique table's row for `t`, and its name.
+const TechniqueInfo& technique_info(Technique t);
 std::string_view technique_name(Technique t);
-
-enum class MisHeuristic : std::uint8_t { Balance, Power };
 
 // As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,
 // `nee-mis:balance`... Mixture weights are kept as given (normalised by
 // SamplingPlan). Parsing validates; see README.md.
 struct Strategy {
   std::array<float, kTechniqueCount> weights{};
+  // Each technique's parameter (TechniqueInfo::parameter; `cosine-power:8`),
+  // its default where the technique has one, else 0.
+  std::array<float, kTechniqueCount> parameters = default_parameters();
   // Next-event estimation: at each diffuse vertex one light sample (shadow ray,
   // solid-angle sampling of the emitters chosen by power) and one cosine
   // sample, combined with multiple importance sampling. `weights` is unused.
   bool nee_mis = false;
   MisHeuristic heuristic = MisHeuristic::Power;
 
+  static std::array<float, kTechniqueCount> default_parameters();
   static Strategy parse(std::string_view text);  // throws InputError
   static Strategy single(Technique t);
   static Strategy nee(MisHeuristic h = MisHeuristic::Power);
   std::string to_string() const;  // canonical form, parses back to the same value
 
   // Unbiased iff some technique with positive weight covers the whole
-  // hemisphere above a diffuse surface (light techniques cover only the targets).
+  // hemisphere above a diffuse surface (TechniqueInfo::covers_hemisphere).
   bool is_unbiased() const;
   bool uses(Technique t) const { return !nee_mis && weights[static_cast<int>(t)] > 0.0f; }
   bool operator==(const Strategy&) const = default;
@@ -88,6 +83,8 @@ struct TargetSet {
 struct SamplingPlan {
   std::array<float, kTechniqueCount> weight{};  // normalised, sum to 1
   std::array<float, kTechniqueCount> cdf{};     // cdf[i] = weight[0] + ... + weight[i]
+  std::array<float, kTechniqueCount> parameter{};  // Strategy::parameters
+  bool uses_frame = false;  // a technique with weight draws in the shading frame
   const Scene* scene = nullptr;
   bool nee_mis = false;
   MisHeuristic heuristic = MisHeuristic::Power;
@@ -108,11 +105,6 @@ struct SamplingPlan {
   // The mixture's pdf for any unit direction.
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
 
-  // The `light` technique alone (the book's hittable_pdf over the targets).
-  DirectionSample sample_light(const Vec3& origin, float u_target, float u1, float u2) const {
-    return book_targets.sample(origin, u_target, u1, u2);
-  }
-  float light_pdf(const Vec3& origin, const Vec3& direction) const { return book_targets.pdf(origin, direction); }
 };
 
 // How much light an emitter sends out (luminance of emit * area * pi, doubled

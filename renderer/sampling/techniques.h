@@ -3,7 +3,7 @@
 // unit direction with its solid-angle pdf, X_pdf(...) evaluates that pdf for any
 // unit direction. The pairs must agree; tests/test_chi_square.cpp checks each.
 #include "renderer/math.h"
-#include "renderer/sampling/onb.h"
+#include "renderer/sampling/leaf.h"
 #include "renderer/scene/scene.h"
 
 namespace pdflab {
@@ -19,127 +19,58 @@ struct DirectionSample {
   bool none = false;
 };
 
-// ---- Hemisphere and sphere techniques (relative to a shading normal) -------
+// The formulas are leaf math (renderer/sampling/leaf_math.inc), shared with
+// the packet tracer; these are their one-path forms.
 
-inline constexpr float kInv2Pi = 0.5f * kInvPi;
-inline constexpr float kInv4Pi = 0.25f * kInvPi;
+inline DirectionSample to_direction_sample(const leaf::Sampled& s) { return {s.direction, s.pdf, s.none}; }
 
 // Cosine-weighted hemisphere: p(w) = cos(theta) / pi.
 inline DirectionSample sample_cosine_hemisphere(const Onb& frame, float u1, float u2) {
-  const float r = std::sqrt(u1);
   float sin_phi, cos_phi;
   sincos_2pi(u2, sin_phi, cos_phi);
-  const float z = std::sqrt(positive_part(1.0f - u1));
-  const Vec3 local(r * cos_phi, r * sin_phi, z);
-  return {frame.to_world(local), z * kInvPi};
+  const Vec3 local = leaf::cosine_hemisphere_local(u1, sin_phi, cos_phi);
+  return {frame.to_world(local), local.z * kInvPi};
 }
 inline float cosine_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
-  const float c = dot(normal, direction);
-  return c > 0.0f ? c * kInvPi : 0.0f;
+  return leaf::cosine_hemisphere_density(dot(normal, direction));
 }
 
 // Uniform hemisphere: p(w) = 1 / (2 pi) above the surface.
 inline DirectionSample sample_uniform_hemisphere(const Onb& frame, float u1, float u2) {
-  const float z = 1.0f - u1;  // (0, 1]: never exactly tangent
-  const float r = std::sqrt(positive_part(1.0f - z * z));
   float sin_phi, cos_phi;
   sincos_2pi(u2, sin_phi, cos_phi);
-  return {frame.to_world(Vec3(r * cos_phi, r * sin_phi, z)), kInv2Pi};
+  return {frame.to_world(leaf::uniform_hemisphere_local(u1, sin_phi, cos_phi)), kInv2Pi};
 }
 inline float uniform_hemisphere_pdf(const Vec3& normal, const Vec3& direction) {
-  return dot(normal, direction) > 0.0f ? kInv2Pi : 0.0f;
+  return leaf::uniform_hemisphere_density(dot(normal, direction));
 }
 
 // Uniform sphere: p(w) = 1 / (4 pi). Half its samples point below the surface.
 inline DirectionSample sample_uniform_sphere(float u1, float u2) {
-  const float z = 1.0f - 2.0f * u1;
-  const float r = std::sqrt(positive_part(1.0f - z * z));
   float sin_phi, cos_phi;
   sincos_2pi(u2, sin_phi, cos_phi);
-  return {Vec3(r * cos_phi, r * sin_phi, z), kInv4Pi};
+  return {leaf::uniform_sphere_direction(u1, sin_phi, cos_phi), kInv4Pi};
 }
 inline float uniform_sphere_pdf() { return kInv4Pi; }
 
-// ---- Area sampling of a quad (the book's quad::random / pdf_value) ---------
-// A uniform point on the quad, converted to solid angle: p = d^2 / (|cos| A).
-
+// Area sampling of a quad (the book's quad::random / pdf_value).
 inline DirectionSample sample_quad_area(const Quad& quad, const Vec3& origin, float u1, float u2) {
-  const Vec3 to_point = quad.q + quad.u * u1 + quad.v * u2 - origin;
-  const float dist2 = dot(to_point, to_point);
-  const float dist = std::sqrt(dist2);
-  const Vec3 direction = to_point * (1.0f / dist);
-  const float cosine = std::fabs(dot(direction, quad.normal));
-  // dist2 == 0 (origin on the sampled point) or cosine == 0 (origin in the
-  // quad's plane): the quad is seen edge-on and offers no direction.
-  if (!(dist2 > 0.0f) || !(cosine > 0.0f)) return {quad.normal, 0.0f, true};
-  return {direction, dist2 / (cosine * quad.area)};
+  return to_direction_sample(leaf::sample_quad_area(quad, origin, u1, u2));
 }
-
 inline float quad_area_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {
-  const float t = quad_hit_distance(quad, origin, direction);
-  if (t < 0.0f) return 0.0f;
-  const float cosine = std::fabs(dot(direction, quad.normal));
-  return t * t / (cosine * quad.area);
+  return leaf::quad_area_pdf(quad, origin, direction);
 }
 
-// ---- Cone sampling of a sphere (the book's sphere::random / pdf_value) ----
-
-struct SphereCone {
-  Vec3 axis;                 // unit, from the origin to the centre
-  float cos_max;             // cosine of the cone's half angle
-  float one_minus_cos_max;   // computed without cancellation
-  bool inside;               // origin inside the sphere: every direction hits it
-};
-
-// 1 - cos(theta_max) = sin^2 / (1 + cos): no cancellation for small or far spheres.
-inline SphereCone sphere_cone(const Sphere& sphere, const Vec3& origin) {
-  const Vec3 to_center = sphere.center - origin;
-  const float dist2 = dot(to_center, to_center);
-  const float r2 = sphere.radius * sphere.radius;
-  SphereCone cone{};
-  if (dist2 <= r2) {
-    cone.inside = true;
-    cone.axis = Vec3(0.0f, 0.0f, 1.0f);
-    cone.cos_max = -1.0f;
-    cone.one_minus_cos_max = 2.0f;
-    return cone;
-  }
-  cone.axis = to_center * (1.0f / std::sqrt(dist2));
-  const float sin2_max = r2 / dist2;
-  cone.cos_max = std::sqrt(positive_part(1.0f - sin2_max));
-  cone.one_minus_cos_max = sin2_max / (1.0f + cone.cos_max);
-  cone.inside = false;
-  return cone;
-}
-
-// From inside the sphere the whole sphere of directions is the target: pdf 1/(4 pi).
+// Cone sampling of a sphere (the book's sphere::random / pdf_value).
+using leaf::SphereCone;
+using leaf::sphere_cone;
 inline DirectionSample sample_sphere_cone(const Sphere& sphere, const Vec3& origin, float u1, float u2) {
-  const SphereCone cone = sphere_cone(sphere, origin);
-  if (cone.inside) return sample_uniform_sphere(u1, u2);
-  const float h = u1 * cone.one_minus_cos_max;  // 1 - cos(theta), uniform in [0, 1 - cos_max)
-  const float cos_theta = 1.0f - h;
-  const float sin_theta = std::sqrt(positive_part(h * (2.0f - h)));
   float sin_phi, cos_phi;
   sincos_2pi(u2, sin_phi, cos_phi);
-  const Onb frame(cone.axis);
-  const Vec3 local(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
-  return {normalize(frame.to_world(local)), 1.0f / (2.0f * kPi * cone.one_minus_cos_max)};
+  return to_direction_sample(leaf::sample_sphere_cone(sphere, origin, u1, sin_phi, cos_phi));
 }
-
 inline float sphere_cone_pdf(const Sphere& sphere, const Vec3& origin, const Vec3& direction) {
-  const Vec3 to_center = sphere.center - origin;
-  const float r2 = sphere.radius * sphere.radius;
-  const float dist2 = dot(to_center, to_center);
-  if (dist2 <= r2) return kInv4Pi;  // inside: every direction reaches the sphere
-  // Most directions miss: decide that first, cheaply and stably, by the squared
-  // distance from the centre to the ray's line (no cancellation for far spheres),
-  // in one branch (see quad_hit_distance).
-  const float along = dot(to_center, direction);
-  const Vec3 perpendicular = to_center - direction * along;
-  if (!((along > 0.0f) & (dot(perpendicular, perpendicular) <= r2))) return 0.0f;
-  const float sin2_max = r2 / dist2;
-  const float one_minus_cos_max = sin2_max / (1.0f + std::sqrt(positive_part(1.0f - sin2_max)));
-  return 1.0f / (2.0f * kPi * one_minus_cos_max);
+  return leaf::sphere_cone_pdf(sphere, origin, direction);
 }
 
 // ---- Solid-angle sampling of a rectangle (spherical rectangle) -------------

@@ -1,5 +1,7 @@
 #include "renderer/scene/scene.h"
 
+#include "renderer/sampling/leaf.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -39,21 +41,10 @@ void Camera::prepare() {
 namespace {
 
 inline bool hit_sphere(const Sphere& sphere, const Ray& ray, float t_max, float& t_out) {
-  // Distance along the ray to the closest approach, and the squared distance of
-  // that point from the centre: stable for far and small spheres, unlike b^2 - 4ac.
-  const Vec3 f = ray.origin - sphere.center;
-  const float b = -dot(f, ray.direction);
-  const Vec3 closest = f + ray.direction * b;
-  const float disc = sphere.radius * sphere.radius - dot(closest, closest);
-  if (disc < 0.0f) return false;
-  const float h = std::sqrt(disc);
-  float t = b - h;
-  if (!(t > 0.0f && t < t_max)) {
-    t = b + h;
-    if (!(t > 0.0f && t < t_max)) return false;
-  }
-  t_out = t;
-  return true;
+  bool hit;
+  const float t = leaf::sphere_hit_distance(sphere, ray.origin, ray.direction, t_max, hit);
+  if (hit) t_out = t;
+  return hit;
 }
 
 // kQuadLanes quads per step in SIMD lanes (GCC/Clang vector extensions: SSE,

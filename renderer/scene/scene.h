@@ -40,19 +40,6 @@ struct Sphere {
 // Builds a quad with its derived plane data. Throws nothing: callers validate u x v != 0.
 Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material);
 
-// Distance along a unit ray to the quad, or a negative value when it misses.
-// The tests are combined with `&` into one branch: whether a direction reaches
-// a target is unpredictable, and one mispredicted branch costs more than the math.
-inline float quad_hit_distance(const Quad& quad, const Vec3& origin, const Vec3& direction) {
-  const float denom = dot(quad.normal, direction);
-  const float t = (quad.plane_d - dot(quad.normal, origin)) / denom;  // +-inf or NaN when parallel
-  const Vec3 rel = origin + direction * t - quad.q;
-  const float a = dot(rel, quad.alpha_axis);
-  const float b = dot(rel, quad.beta_axis);
-  const bool hit = (t > 0.0f) & (t < kInf) & (a >= 0.0f) & (a <= 1.0f) & (b >= 0.0f) & (b <= 1.0f);
-  return hit ? t : -1.0f;
-}
-
 // An object that the `light` techniques aim at (the book's `lights` list).
 struct Target {
   enum class Kind : std::uint8_t { Quad, Sphere } kind;
@@ -121,20 +108,7 @@ struct Hit {
 };
 
 // Closest intersection along the ray with t in (0, t_max). Origins are offset by
-// the caller (spawn_ray), so no t_min epsilon is needed here.
+// the caller (spawn_ray, renderer/sampling/leaf.h), so no t_min epsilon is needed here.
 bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit);
-
-// A new ray leaving `point` in `direction`, moved off the surface along the
-// normal on the side the direction goes, by an offset that scales with the
-// coordinates' magnitude (float spacing grows with it).
-inline Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
-  // About 8 float ulps of the largest coordinate (2^-20 relative): the hit
-  // point's rounding error is a few ulps (tests/test_extremes.cpp shows rays
-  // re-hitting their own surface at 1e5 with no offset), plus an absolute floor
-  // for points near the origin. Small enough not to skip walls 0.25 units thick at 1e5.
-  const float offset = 1e-4f + 1e-6f * max_abs_component(point);
-  const float side = dot(direction, geometric_normal) >= 0.0f ? offset : -offset;
-  return Ray{point + geometric_normal * side, direction};
-}
 
 }  // namespace pdflab

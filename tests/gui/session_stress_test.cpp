@@ -67,11 +67,12 @@ TEST(SessionStress, ThousandChangesWhileRendering) {
   bool paused = false;
   for (int change = 0; change < 1000; ++change) {
     switch (rng() % 6) {
-      case 0:  // a new mixture, weights from the sliders
-        for (float& w : rs.strategy.weights) w = uniform(0.0f, 1.0f) < 0.3f ? 0.0f : uniform(0.0f, 1.0f);
-        if (rs.strategy.weights[0] + rs.strategy.weights[1] + rs.strategy.weights[2] + rs.strategy.weights[3] == 0.0f)
-          rs.strategy.weights[0] = 1.0f;
+      case 0: {  // a new mixture, weights from the sliders
+        float total = 0.0f;
+        for (float& w : rs.strategy.weights) total += w = uniform(0.0f, 1.0f) < 0.3f ? 0.0f : uniform(0.0f, 1.0f);
+        if (total == 0.0f) rs.strategy.weights[static_cast<int>(Technique::Cosine)] = 1.0f;
         break;
+      }
       case 1:  // a single technique
         rs.strategy = Strategy::single(static_cast<Technique>(rng() % kTechniqueCount));
         break;

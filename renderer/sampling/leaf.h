@@ -1,0 +1,69 @@
+#pragma once
+// The leaf math (leaf_math.inc) for one path at a time: Float is float and a
+// Mask is a bool. The packet tracer compiles the same file for its SIMD lanes
+// (renderer/integrator/packet_kernel.inc); the one-path tracer, the probe and
+// the tests call these.
+#include "renderer/math.h"
+#include "renderer/scene/scene.h"
+
+#include <cstdint>
+
+namespace pdflab {
+
+enum class MisHeuristic : std::uint8_t { Balance, Power };
+
+namespace leaf {
+
+#define PDFLAB_LEAF inline
+
+using Float = float;
+using Int = std::int32_t;
+using Mask = bool;
+using V3 = Vec3;
+
+PDFLAB_LEAF Float splat(float x) { return x; }
+PDFLAB_LEAF Int splat_i(std::int32_t x) { return x; }
+PDFLAB_LEAF const V3& splat3(const Vec3& v) { return v; }
+PDFLAB_LEAF Float lane_sqrt(Float x) { return std::sqrt(x); }
+PDFLAB_LEAF Float lane_abs(Float x) { return std::fabs(x); }
+PDFLAB_LEAF Float lane_sign(Float x) { return std::copysign(1.0f, x); }
+PDFLAB_LEAF Float lane_max(Float a, Float b) { return max_of(a, b); }
+PDFLAB_LEAF Int lane_trunc(Float x) { return static_cast<Int>(x); }
+PDFLAB_LEAF Float lane_float(Int x) { return static_cast<Float>(x); }
+PDFLAB_LEAF Mask lane_not(Mask m) { return !m; }
+PDFLAB_LEAF Int increment_where(Int x, Mask m) { return m ? x + 1 : x; }
+PDFLAB_LEAF bool any(Mask m) { return m; }
+PDFLAB_LEAF Float select(Mask m, Float a, Float b) { return m ? a : b; }
+PDFLAB_LEAF Int select(Mask m, Int a, Int b) { return m ? a : b; }
+PDFLAB_LEAF V3 select(Mask m, const V3& a, const V3& b) { return m ? a : b; }
+PDFLAB_LEAF Float lane_pow(Float x, float e) { return std::pow(x, e); }
+// One path is one lane: lane 0, there when the mask is.
+template <class F>
+PDFLAB_LEAF void each_lane(Mask m, F f) {
+  if (m) f(0);
+}
+PDFLAB_LEAF const Vec3& lane_vec3(const V3& v, int) { return v; }
+PDFLAB_LEAF float lane_value(Float v, int) { return v; }
+PDFLAB_LEAF void set_lane_vec3(V3& v, int, const Vec3& x) { v = x; }
+PDFLAB_LEAF void set_lane_value(Float& v, int, float x) { v = x; }
+PDFLAB_LEAF void set_lane_mask(Mask& m, int, bool x) { m = x; }
+
+#include "renderer/sampling/leaf_math.inc"
+
+#undef PDFLAB_LEAF
+
+}  // namespace leaf
+
+using leaf::kInv2Pi;
+using leaf::kInv4Pi;
+using leaf::mis_weight;
+using leaf::Onb;
+using leaf::sincos_2pi;
+using leaf::quad_hit_distance;
+
+// A new ray leaving `point` in `direction` (leaf::spawn_origin).
+inline Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
+  return Ray{leaf::spawn_origin(point, geometric_normal, direction), direction};
+}
+
+}  // namespace pdflab

@@ -1,0 +1,61 @@
+// The table of sampling techniques. Everything that lists techniques — the
+// strategy parser and its messages, the mixture in both tracers, the viewer's
+// sliders and probe, `--help`, the chi-square suite — iterates this table; no
+// code names a technique by its position. docs/adding_a_technique.md adds one.
+//
+// Read twice: plainly, for the list (PDFLAB_TECHNIQUES, below); with
+// PDFLAB_TECHNIQUE_BODIES defined, inside a lane namespace, for each
+// technique's sample and pdf (renderer/sampling/techniques/*.inc).
+#if defined(PDFLAB_TECHNIQUE_BODIES)
+
+#include "renderer/sampling/techniques/cosine.inc"
+#include "renderer/sampling/techniques/uniform_hemisphere.inc"
+#include "renderer/sampling/techniques/uniform_sphere.inc"
+#include "renderer/sampling/techniques/light.inc"
+#include "renderer/sampling/techniques/light_solid_angle.inc"
+#include "renderer/sampling/techniques/cosine_power.inc"
+
+#elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
+#define PDFLAB_TECHNIQUE_TABLE_H
+
+// X(Type): one row per technique, in the order the panel and the messages show them.
+#define PDFLAB_TECHNIQUES(X) \
+  X(Cosine)                  \
+  X(UniformHemisphere)       \
+  X(UniformSphere)           \
+  X(Light)                   \
+  X(LightSolidAngle)         \
+  X(CosinePower)
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+namespace pdflab {
+
+enum class Technique : std::uint8_t {
+#define PDFLAB_ENUM_ROW(T) T,
+  PDFLAB_TECHNIQUES(PDFLAB_ENUM_ROW)
+#undef PDFLAB_ENUM_ROW
+  Count
+};
+inline constexpr int kTechniqueCount = static_cast<int>(Technique::Count);
+
+// What the rest of the program knows of a technique besides its math.
+struct TechniqueInfo {
+  std::string_view name;      // as typed in a strategy
+  std::string_view draws;     // what it draws, for --help and the README
+  std::string_view pdf;       // its density, as a formula
+  // Its pdf is positive over the whole hemisphere above a diffuse surface:
+  // alone it is unbiased; the light techniques cover only their targets.
+  bool covers_hemisphere;
+  bool draws_target;  // draws one more random number, for the target
+  std::array<std::uint8_t, 3> colour;  // its samples in the probe
+  // A parameter written `name:P` (0 chars: none), its default and range.
+  std::string_view parameter;
+  float parameter_default = 0.0f, parameter_min = 0.0f, parameter_max = 0.0f;
+};
+
+}  // namespace pdflab
+
+#endif
