@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
   std::string view_scene, view_strategy = "mix:cosine=0.5,light=0.5", screenshot;
   std::uint32_t view_spp = 0;
   app.add_option("--scene", view_scene, "Scene file (default: the book's Cornell box)");
-  CLI::Option* view_strategy_option = app.add_option("--strategy", view_strategy, "Sampling strategy (see README)");
+  CLI::Option* view_strategy_option = app.add_option("--strategy", view_strategy, "Sampling strategy (below)");
+  app.footer(pdflab::strategy_help());
   app.add_option("--spp", view_spp, "With --screenshot: samples per pixel to render before saving")
       ->check(CLI::Range(1u, 1u << 30));
   app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
 
   pdflab::RenderOptions ro;
   CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
+  render->footer(pdflab::strategy_help());
   CLI::Option* scene_option = render->add_option("--scene", ro.scene, "Scene file (JSON); with --resume, default: the film's");
   CLI::Option* strategy_option = render->add_option("--strategy", ro.strategy,
                      "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5; with --resume, default: the film's");

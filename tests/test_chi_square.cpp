@@ -4,6 +4,7 @@
 // cell is N times the integral of the pdf over it, computed by adaptive
 // quadrature of the pdf function itself (so sample_X and X_pdf are checked
 // against each other, never against a shared formula).
+#include "renderer/integrator/packet.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/sampling/techniques.h"
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <numbers>
@@ -446,9 +448,62 @@ const std::vector<ChiCase>& chi_cases() {
   return cases;
 }
 
+// Every technique in the table, alone and in a mixture, from the shading
+// points where sampling code breaks: inside a sphere target, a quad seen
+// edge-on, a quad straddling the horizon (grazing), and a normal along -z (the
+// branch point of the frame). A new technique gets these with no edit here.
+const std::vector<ChiCase>& table_cases() {
+  static const std::vector<ChiCase> cases = [] {
+    struct EdgePoint {
+      const char* name;
+      Targets targets;
+      Vec3 origin, normal;
+    };
+    const EdgePoint points[] = {
+        {"inside_sphere", Targets::Sphere, {0.1f, 2.1f, 0}, {0, 1, 0}},
+        {"quad_edge_on", Targets::QuadEdgeOn, {0, 0.2f, 0}, {0, 1, 0}},
+        {"grazing", Targets::QuadUpright, {0, 0.3f, 0}, {0, 1, 0}},
+        {"minus_z", Targets::TwoOverlapping, {0, 0, 0}, {0, 0, -1}},
+    };
+    static std::deque<std::string> texts;  // the names and strategies the cases point into
+    std::vector<ChiCase> out;
+    for (int i = 0; i < kTechniqueCount; ++i) {
+      const TechniqueInfo& t = technique_info(static_cast<Technique>(i));
+      std::string id(t.name);
+      std::replace(id.begin(), id.end(), '-', '_');
+      const std::string partner = t.name == "cosine" ? "uniform-sphere" : "cosine";
+      for (const EdgePoint& p : points) {
+        for (const bool mixed : {false, true}) {
+          texts.push_back("table_" + id + (mixed ? "_mix_" : "_") + p.name);
+          const char* name = texts.back().c_str();
+          texts.push_back(mixed ? "mix:" + partner + "=0.5," + std::string(t.name) + "=0.5" : std::string(t.name));
+          out.push_back({name, texts.back().c_str(), p.targets, p.origin, p.normal});
+        }
+      }
+    }
+    return out;
+  }();
+  return cases;
+}
+
+// The sampler under test: the one-path draw (SamplingPlan::sample), or the
+// packet kernel's (sample_plan), which is what renders.
+enum class Sampler { OnePath, Packet };
+
+std::vector<ChiCase> all_cases() {
+  std::vector<ChiCase> v = chi_cases();
+  v.insert(v.end(), table_cases().begin(), table_cases().end());
+  return v;
+}
+const std::vector<ChiCase>& every_case() {
+  static const std::vector<ChiCase> v = all_cases();
+  return v;
+}
+
 // Every case is one test of the family; Sidak keeps the family's false-alarm
 // rate at 1% for the whole list.
-double alpha_per_test() { return stats::sidak_alpha(kFamilyAlpha, static_cast<int>(chi_cases().size())); }
+// Both samplers run every case but the emitter sets'.
+double alpha_per_test() { return stats::sidak_alpha(kFamilyAlpha, 2 * static_cast<int>(every_case().size())); }
 
 struct PlanUnderTest {
   std::unique_ptr<Scene> scene;
@@ -470,23 +525,52 @@ double case_density(const ChiCase& c, const PlanUnderTest& p, const Vec3& d) {
   return static_cast<double>(c.emitter_set ? p.plan.emitters.pdf(p.origin, d) : p.plan.pdf(p.origin, p.normal, d));
 }
 
-Outcome run_case(const ChiCase& c, std::uint64_t seed) {
+// The packet kernel's draws, a batch at a time, handed out one by one; each
+// draw takes four numbers (technique, direction, target) from the stream.
+class PacketSampler {
+ public:
+  PacketSampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal)
+      : plan_(plan), origin_(origin), normal_(normal) {}
+  DirectionSample operator()(Rng& rng) {
+    if (next_ == batch_.size()) {
+      std::vector<PlanDraw> draws(kBatch);
+      for (PlanDraw& d : draws) {
+        d.point = origin_, d.normal = normal_;
+        d.u0 = rng.uniform(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.uniform();
+      }
+      batch_.resize(kBatch);
+      sample_plan(best_packet_isa(), plan_, draws.data(), draws.size(), batch_.data());
+      next_ = 0;
+    }
+    return batch_[next_++];
+  }
+
+ private:
+  static constexpr std::size_t kBatch = 256;
+  const SamplingPlan& plan_;
+  Vec3 origin_, normal_;
+  std::vector<DirectionSample> batch_;
+  std::size_t next_ = 0;
+};
+
+Outcome run_case(const ChiCase& c, std::uint64_t seed, Sampler which = Sampler::OnePath) {
   const PlanUnderTest p = bind(c);
   const Frame frame(p.normal);
   auto density = [&](const Vec3& d) { return case_density(c, p, d); };
+  const std::vector<Point> outlines = target_outlines(*p.scene, p.origin, frame);
+  if (which == Sampler::Packet)
+    return run_chi_square(frame, PacketSampler(p.plan, p.origin, p.normal), density, outlines, seed);
   auto sampler = [&](Rng& rng) {
     if (!c.emitter_set) return p.plan.sample(p.origin, p.normal, rng);
     const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     return p.plan.emitters.sample(p.origin, uc, u1, u2);
   };
-  return run_chi_square(frame, sampler, density, target_outlines(*p.scene, p.origin, frame), seed);
+  return run_chi_square(frame, sampler, density, outlines, seed);
 }
 
 class ChiSquare : public ::testing::TestWithParam<int> {};
 
-TEST_P(ChiSquare, SamplesFollowPdf) {
-  const ChiCase& c = chi_cases()[GetParam()];
-  const Outcome o = run_case(c, 1000 + static_cast<std::uint64_t>(GetParam()));
+void expect_follows_pdf(const ChiCase& c, const Outcome& o) {
   const double alpha = alpha_per_test();
   std::printf("[chi2] %-40s chi2 %10.2f  dof %4d  p %.4g  (alpha %.3g, pooled %d, mismatches %llu)\n", c.name,
               o.chi.statistic, o.chi.dof, o.chi.p_value, alpha, o.chi.pooled_cells,
@@ -502,6 +586,18 @@ TEST_P(ChiSquare, SamplesFollowPdf) {
   EXPECT_GT(o.chi.p_value, alpha) << "chi2 = " << o.chi.statistic << ", dof = " << o.chi.dof;
 }
 
+TEST_P(ChiSquare, SamplesFollowPdf) {
+  const ChiCase& c = every_case()[GetParam()];
+  expect_follows_pdf(c, run_case(c, 1000 + static_cast<std::uint64_t>(GetParam())));
+}
+
+// The same through the packet kernel's sampler, the code that renders.
+TEST_P(ChiSquare, PacketSamplesFollowPdf) {
+  const ChiCase& c = every_case()[GetParam()];
+  if (c.emitter_set) GTEST_SKIP() << "the emitter set is sampled per lane by the one-path code";
+  expect_follows_pdf(c, run_case(c, 5000 + static_cast<std::uint64_t>(GetParam()), Sampler::Packet));
+}
+
 // The pdf integrates to 1 over the sphere; for `light`, whose pdf is zero off
 // the targets, that is the integral over the directions that reach a target.
 // Tolerance: the quadrature's own error, measured on these cases, is at most
@@ -512,7 +608,7 @@ TEST_P(ChiSquare, SamplesFollowPdf) {
 // Jacobian, a target counted twice or with the wrong 1/targets, a mixture
 // weight not normalised: all percent-level or worse).
 TEST_P(ChiSquare, PdfIntegratesToOne) {
-  const ChiCase& c = chi_cases()[GetParam()];
+  const ChiCase& c = every_case()[GetParam()];
   const PlanUnderTest p = bind(c);
   const Frame frame(p.normal);
   auto density = [&](const Vec3& d) { return case_density(c, p, d); };
@@ -523,9 +619,9 @@ TEST_P(ChiSquare, PdfIntegratesToOne) {
   EXPECT_NEAR(total, 1.0, 2e-4);
 }
 
-INSTANTIATE_TEST_SUITE_P(Techniques, ChiSquare, ::testing::Range(0, static_cast<int>(chi_cases().size())),
+INSTANTIATE_TEST_SUITE_P(Techniques, ChiSquare, ::testing::Range(0, static_cast<int>(every_case().size())),
                          [](const ::testing::TestParamInfo<int>& param_info) {
-                           return std::string(chi_cases()[param_info.param].name);
+                           return std::string(every_case()[param_info.param].name);
                          });
 
 // ---- The test itself has power: wrong pdfs are rejected ------------------

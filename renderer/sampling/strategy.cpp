@@ -93,6 +93,24 @@ float parse_weight(std::string_view text, std::string_view whole) {
 const TechniqueInfo& technique_info(Technique t) { return kTable[static_cast<int>(t)]; }
 std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)].name; }
 
+std::string strategy_help() {
+  std::string out =
+      "Strategies: TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...] | nee-mis | nee-mis:balance\nTechniques:\n";
+  for (const TechniqueInfo& t : kTable) {
+    std::string name(t.name);
+    if (!t.parameter.empty())
+      name.append("[:").append(t.parameter).append("]");
+    out.append("  ").append(name).append(name.size() < 20 ? 20 - name.size() : 1, ' ');
+    out.append(t.draws).append("; pdf ").append(t.pdf);
+    if (!t.parameter.empty())
+      out.append("; ").append(t.parameter).append(" in [").append(format_number(t.parameter_min)).append(", ")
+          .append(format_number(t.parameter_max)).append("], default ").append(format_number(t.parameter_default));
+    if (!t.covers_hemisphere) out.append(" (biased alone: sees only its targets)");
+    out.append("\n");
+  }
+  return out;
+}
+
 std::array<float, kTechniqueCount> Strategy::default_parameters() {
   std::array<float, kTechniqueCount> p{};
   for (int i = 0; i < kTechniqueCount; ++i) p[i] = kTable[i].parameter_default;

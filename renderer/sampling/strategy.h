@@ -17,6 +17,10 @@ namespace pdflab {
 
 // The technique table's row for `t`, and its name.
 const TechniqueInfo& technique_info(Technique t);
+
+// The strategy grammar and every technique in the table (what it draws, its
+// pdf, whether it is biased alone): the text of `--help`.
+std::string strategy_help();
 std::string_view technique_name(Technique t);
 
 // As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,

@@ -1,0 +1,193 @@
+// The technique table and the leaf math, checked exactly and fast (no
+// statistics; these also run under the sanitizers): every technique's sample
+// agrees with its own pdf, the warps invert back to their random numbers, the
+// packet kernel draws the one-path code's bits, and the table is what the
+// parser and its messages know.
+#include "renderer/error.h"
+#include "renderer/integrator/packet.h"
+#include "renderer/sampling/mixture.h"
+#include "renderer/sampling/rng.h"
+#include "renderer/scene/scene_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+namespace {
+
+const Scene& book() {
+  static const Scene s = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  return s;
+}
+
+// Each technique alone and mixed half and half with another.
+std::vector<Strategy> strategies() {
+  std::vector<Strategy> out;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const std::string name(technique_info(static_cast<Technique>(i)).name);
+    out.push_back(Strategy::parse(name));
+    out.push_back(Strategy::parse("mix:" + std::string(name == "cosine" ? "light" : "cosine") + "=0.5," + name + "=0.5"));
+  }
+  return out;
+}
+
+// Shading points inside the book's box with random normals, and draws.
+std::vector<PlanDraw> draws(std::size_t n, std::uint64_t seed) {
+  Rng rng(seed, 7);
+  std::vector<PlanDraw> out(n);
+  for (PlanDraw& d : out) {
+    d.point = Vec3(555.0f * rng.uniform(), 555.0f * rng.uniform(), 555.0f * rng.uniform());
+    d.normal = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
+    d.u0 = rng.uniform(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.uniform();
+  }
+  return out;
+}
+
+bool same_bits(const DirectionSample& a, const DirectionSample& b) {
+  return std::memcmp(&a.direction, &b.direction, sizeof a.direction) == 0 &&
+         std::memcmp(&a.pdf, &b.pdf, sizeof a.pdf) == 0 && a.none == b.none;
+}
+
+DirectionSample one_path(const SamplingPlan& plan, const PlanDraw& d) {
+  const int chosen = leaf::choose_technique(plan, d.u0);
+  const leaf::Shading at(plan, d.point, d.normal, d.u1, d.u2, d.u_choice);
+  return to_direction_sample(leaf::sample_mixture(plan, at, chosen, true));
+}
+
+std::vector<PacketIsa> isas() {
+  std::vector<PacketIsa> v{PacketIsa::Generic};
+  if (best_packet_isa() == PacketIsa::Avx2) v.push_back(PacketIsa::Avx2);
+  return v;
+}
+
+TEST(Techniques, PacketDrawsTheOnePathBits) {
+  const std::vector<PlanDraw> in = draws(203, 1);  // not a multiple of the lanes
+  for (const Strategy& strategy : strategies()) {
+    const SamplingPlan plan = SamplingPlan::make(strategy, book());
+    for (const PacketIsa isa : isas()) {
+      std::vector<DirectionSample> packet(in.size());
+      sample_plan(isa, plan, in.data(), in.size(), packet.data());
+      std::vector<Vec3> directions;
+      for (const DirectionSample& s : packet) directions.push_back(s.direction);
+      std::vector<float> pdf(in.size());
+      plan_pdf(isa, plan, in.data(), directions.data(), in.size(), pdf.data());
+      int differing = 0, pdf_differing = 0;
+      for (std::size_t i = 0; i < in.size(); ++i) {
+        differing += !same_bits(one_path(plan, in[i]), packet[i]);
+        const float scalar_pdf = plan.pdf(in[i].point, in[i].normal, directions[i]);
+        pdf_differing += std::memcmp(&scalar_pdf, &pdf[i], sizeof scalar_pdf) != 0;
+      }
+      EXPECT_EQ(differing, 0) << strategy.to_string() << " with " << packet_isa_name(isa);
+      EXPECT_EQ(pdf_differing, 0) << strategy.to_string() << " with " << packet_isa_name(isa);
+    }
+  }
+}
+
+// sample then pdf: the density a technique reports for its own sample is its
+// pdf at that direction (up to float rounding of two formulas for one value).
+TEST(Techniques, SampleAgreesWithPdf) {
+  const std::vector<PlanDraw> in = draws(2000, 2);
+  for (const Strategy& strategy : strategies()) {
+    const SamplingPlan plan = SamplingPlan::make(strategy, book());
+    int checked = 0;
+    for (const PlanDraw& d : in) {
+      const DirectionSample s = one_path(plan, d);
+      if (s.none) continue;
+      ASSERT_GT(s.pdf, 0.0f) << strategy.to_string();
+      const float p = plan.pdf(d.point, d.normal, s.direction);
+      // The light's targets: a sample on a target's very edge may miss it on re-intersection.
+      if (p == 0.0f && !strategy.is_unbiased()) continue;
+      EXPECT_NEAR(p, s.pdf, 2e-4f * s.pdf) << strategy.to_string();
+      ++checked;
+    }
+    EXPECT_GT(checked, 1000) << strategy.to_string();
+  }
+}
+
+// The warps' inverses: the random numbers come back from the direction.
+TEST(Techniques, HemisphereWarpsInvert) {
+  Rng rng(3, 3);
+  for (int i = 0; i < 10000; ++i) {
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    float s, c;
+    leaf::sincos_2pi(u2, s, c);
+    auto azimuth = [](const Vec3& v) {
+      const double phi = std::atan2(static_cast<double>(v.y), static_cast<double>(v.x)) / (2.0 * std::numbers::pi);
+      return phi < 0.0 ? phi + 1.0 : phi;
+    };
+    auto same_azimuth = [&](const Vec3& v) {
+      const double d = std::fabs(azimuth(v) - u2);
+      return std::min(d, 1.0 - d) < 2e-5 || std::hypot(v.x, v.y) < 1e-3f;
+    };
+    const Vec3 cosine = leaf::cosine_hemisphere_local(u1, s, c);
+    EXPECT_NEAR(cosine.x * cosine.x + cosine.y * cosine.y, u1, 2e-6f);
+    EXPECT_TRUE(same_azimuth(cosine)) << u2;
+    const Vec3 hemisphere = leaf::uniform_hemisphere_local(u1, s, c);
+    EXPECT_NEAR(1.0f - hemisphere.z, u1, 1e-6f);
+    EXPECT_TRUE(same_azimuth(hemisphere)) << u2;
+    const Vec3 sphere = leaf::uniform_sphere_direction(u1, s, c);
+    EXPECT_NEAR((1.0f - sphere.z) * 0.5f, u1, 1e-6f);
+    EXPECT_TRUE(same_azimuth(sphere)) << u2;
+  }
+}
+
+TEST(Techniques, CosinePowerInvertsAndMatchesItsNeighbours) {
+  // N = 0 is the uniform hemisphere's density, N = 1 the cosine lobe's.
+  for (const float c : {0.01f, 0.3f, 0.7f, 1.0f}) {
+    EXPECT_NEAR(leaf::CosinePower::density(0.0f, c), leaf::uniform_hemisphere_density(c), 1e-7f);
+    EXPECT_NEAR(leaf::CosinePower::density(1.0f, c), leaf::cosine_hemisphere_density(c), 1e-7f);
+  }
+  EXPECT_EQ(leaf::CosinePower::density(8.0f, -0.1f), 0.0f);
+  const Scene& scene = book();
+  for (const float n : {0.0f, 1.0f, 8.0f, 100.0f}) {
+    Strategy strategy = Strategy::parse("cosine-power");
+    strategy.parameters[static_cast<int>(Technique::CosinePower)] = n;
+    const SamplingPlan plan = SamplingPlan::make(strategy, scene);
+    Rng rng(4, 4);
+    for (int i = 0; i < 2000; ++i) {
+      const float u1 = rng.uniform();
+      const leaf::Shading at(plan, Vec3(0.0f), Vec3(0, 0, 1), u1, rng.uniform(), 0.0f);
+      const leaf::Sampled s = leaf::CosinePower::sample(plan, at, true);
+      // cos = (1 - u1)^(1 / (N + 1)) inverts to u1 = 1 - cos^(N + 1).
+      EXPECT_NEAR(1.0f - std::pow(s.direction.z, n + 1.0f), u1, 3e-5f) << n;
+      EXPECT_GT(s.direction.z, 0.0f);
+      EXPECT_NEAR(length(s.direction), 1.0f, 1e-5f);
+    }
+  }
+}
+
+// The table is what the parser knows and what its messages list.
+TEST(Techniques, TableDrivesParserAndMessages) {
+  std::string unknown_message;
+  try {
+    (void)Strategy::parse("no-such-technique");
+  } catch (const InputError& e) {
+    unknown_message = e.what();
+  }
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const auto t = static_cast<Technique>(i);
+    const TechniqueInfo& info = technique_info(t);
+    const Strategy s = Strategy::parse(info.name);
+    EXPECT_EQ(s.weights[i], 1.0f) << info.name;
+    EXPECT_EQ(Strategy::parse(s.to_string()), s) << info.name;
+    EXPECT_EQ(s.is_unbiased(), info.covers_hemisphere) << info.name;
+    EXPECT_NE(unknown_message.find(std::string(info.name)), std::string::npos) << info.name;
+    EXPECT_NE(strategy_help().find(std::string(info.name)), std::string::npos) << info.name;
+    EXPECT_FALSE(info.draws.empty());
+    if (info.parameter.empty()) {
+      EXPECT_THROW((void)Strategy::parse(std::string(info.name) + ":2"), InputError) << info.name;
+    }
+  }
+  const Strategy p = Strategy::parse("mix:cosine-power:20=1,light=1");
+  EXPECT_EQ(p.parameters[static_cast<int>(Technique::CosinePower)], 20.0f);
+  EXPECT_EQ(Strategy::parse(p.to_string()).to_string(), p.to_string());
+  EXPECT_THROW((void)Strategy::parse("cosine-power:-1"), InputError);
+  EXPECT_THROW((void)Strategy::parse("cosine-power:1e9"), InputError);
+  EXPECT_THROW((void)Strategy::parse("cosine-power:"), InputError);
+}
+
+}  // namespace
+}  // namespace pdflab
