@@ -1,4 +1,4 @@
-// pdflab: the viewer (default) and the headless commands. See INTERFACE.md / README.md.
+// pdflab: the viewer (default) and the headless commands. See README.md.
 #include "app/assets.h"
 #include "app/bench_command.h"
 #include "app/reference_command.h"

@@ -1,4 +1,4 @@
-// The `pdflab render` contract from INTERFACE.md, checked on the real binary:
+// The `pdflab render` contract from README.md, checked on the real binary:
 // each class of bad input exits 2 with one message naming the problem and
 // writes nothing; a small render writes the image, the stats JSON and a summary.
 #include "renderer/film/image_io.h"

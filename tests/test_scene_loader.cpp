@@ -1,4 +1,4 @@
-// Scene loading: the book's scene comes out as DESIGN.md/INTERFACE.md describe,
+// Scene loading: the book's scene comes out as docs/scene_format.md describes,
 // and every class of bad input is an InputError whose message points at the
 // offending JSON path (or line and column for syntax errors).
 #include "renderer/error.h"

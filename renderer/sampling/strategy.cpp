@@ -383,7 +383,7 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   const float u2 = rng.uniform();
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
-  const float u_choice = leaf::draws_target(chosen) ? rng.uniform() : 0.0f;
+  const float u_choice = leaf::draws_target(*this, chosen) ? rng.uniform() : 0.0f;
   return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
 }
 

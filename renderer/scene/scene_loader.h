@@ -1,5 +1,5 @@
 #pragma once
-// Scene files (JSON, see INTERFACE.md). Every problem is an InputError whose
+// Scene files (JSON, docs/scene_format.md). Every problem is an InputError whose
 // message names the file and the JSON path (`objects[3].radius`), or the line
 // and column of a syntax error.
 #include "renderer/scene/scene.h"
