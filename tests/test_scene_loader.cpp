@@ -315,6 +315,54 @@ TEST(SceneValidation, DegenerateQuads) {
   expect_error_mentions(doc, {"objects[1]", "degenerate"});
 }
 
+TEST(SceneValidation, QuadMessagesGiveTheTrueReason) {
+  json doc = minimal_scene();
+  doc["objects"][1]["v"] = json::array({4, 0, 0});
+  expect_error_mentions(doc, {"objects[1]:", "u and v are parallel"});
+  doc = minimal_scene();
+  doc["objects"][1]["u"] = json::array({0, 0, 0});
+  expect_error_mentions(doc, {"objects[1]:", "u is zero"});
+  doc = minimal_scene();
+  doc["objects"][1]["v"] = json::array({0, 0, 0});
+  expect_error_mentions(doc, {"objects[1]:", "v is zero"});
+  // Edges of 1e20: the area 1e40 cannot be held in float.
+  doc = minimal_scene();
+  doc["objects"][1]["u"] = json::array({1e20, 0, 0});
+  doc["objects"][1]["v"] = json::array({0, 0, 1e20});
+  expect_error_mentions(doc, {"objects[1]:", "area", "does not fit in single precision"});
+  // Edges of 1e-20: the area 1e-40 is below float's normal range.
+  doc = minimal_scene();
+  doc["objects"][1]["u"] = json::array({1e-20, 0, 0});
+  doc["objects"][1]["v"] = json::array({0, 0, 1e-20});
+  expect_error_mentions(doc, {"objects[1]:", "area", "too small for single precision"});
+  // A box face is a quad too.
+  doc = minimal_scene();
+  doc["objects"][1] = json{{"type", "box"}, {"min", {0, 0, 0}}, {"max", {1e20, 1e20, 1}}, {"material", "white"}};
+  expect_error_mentions(doc, {"objects[1]:", "does not fit in single precision"});
+}
+
+TEST(SceneGeometry, QuadSetUpIsFiniteAndExactFromTinyToHugeEdges) {
+  // In float |u x v|^2 overflows near edges of 4e9; the set-up is done in double.
+  for (const double edge : {1e-12, 1e-6, 1.0, 1e6, 4e9, 1e12, 1e18}) {
+    const float e = static_cast<float>(edge);
+    const Vec3 u(e, 0, 0), v(0.6f * e, 0.8f * e, 0);  // 53 degrees apart
+    ASSERT_EQ(quad_problem(u, v), "") << edge;
+    const Quad q = make_quad(Vec3(2 * e, -e, 3 * e), u, v, 0);
+    EXPECT_NEAR(q.area / (0.8 * edge * edge), 1.0, 1e-6) << edge;
+    EXPECT_NEAR(length(q.normal), 1.0f, 1e-6f) << edge;
+    EXPECT_NEAR(q.normal.z, 1.0f, 1e-6f) << edge;
+    EXPECT_NEAR(q.plane_d / (3 * edge), 1.0, 1e-6) << edge;
+    // The plane axes map the far corner to (1, 1).
+    const Vec3 rel = u + v;
+    EXPECT_NEAR(dot(rel, q.alpha_axis), 1.0f, 1e-5f) << edge;
+    EXPECT_NEAR(dot(rel, q.beta_axis), 1.0f, 1e-5f) << edge;
+    // And a ray down the middle hits it at the right distance.
+    const Vec3 centre = Vec3(2 * e, -e, 3 * e) + rel * 0.5f;
+    const float t = quad_hit_distance(q, centre + Vec3(0, 0, 2 * e), Vec3(0, 0, -1));
+    EXPECT_NEAR(t / (2 * edge), 1.0, 1e-5) << edge;
+  }
+}
+
 TEST(SceneValidation, NonPositiveRadius) {
   for (double r : {0.0, -1.0, -0.0}) {
     json doc = minimal_scene();

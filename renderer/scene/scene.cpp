@@ -3,24 +3,74 @@
 #include "renderer/sampling/leaf.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
+#include <limits>
+#include <string>
 
 namespace pdflab {
+
+// The derived plane data in double, rounded once to float at the end: in float,
+// |u x v|^2 overflows for edges near 4e9 and underflows for edges near 1e-10,
+// while each derived quantity itself fits easily (quad_problem says when not).
+namespace {
+struct DVec {
+  double x, y, z;
+};
+DVec dvec(const Vec3& v) { return {v.x, v.y, v.z}; }
+DVec dcross(const DVec& a, const DVec& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double ddot(const DVec& a, const DVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+DVec dscale(const DVec& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+Vec3 to_float(const DVec& a) { return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)}; }
+}  // namespace
+
+std::string quad_problem(const Vec3& u, const Vec3& v) {
+  const DVec du = dvec(u), dv = dvec(v);
+  const double lu = std::sqrt(ddot(du, du)), lv = std::sqrt(ddot(dv, dv));
+  const auto show = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", x);
+    return std::string(buf);
+  };
+  if (lu == 0.0 && lv == 0.0) return "degenerate quad: u and v are both zero";
+  if (lu == 0.0) return "degenerate quad: u is zero";
+  if (lv == 0.0) return "degenerate quad: v is zero";
+  const DVec n = dcross(du, dv);
+  const double area = std::sqrt(ddot(n, n));
+  // u and v come from float, so their cross product is exact to double rounding:
+  // a sine below 1e-7 means parallel up to the input's own precision.
+  const double sine = area / (lu * lv);
+  if (!(sine > 1e-7))
+    return "degenerate quad: u and v are parallel (the sine of the angle between them is " + show(sine) + ")";
+  if (area > static_cast<double>(std::numeric_limits<float>::max()))
+    return "the quad's area " + show(area) + " does not fit in single precision (at most " +
+           show(std::numeric_limits<float>::max()) + ")";
+  // Its reciprocal scales the light pdf d^2 / (cos A) and the plane axes.
+  if (area < static_cast<double>(std::numeric_limits<float>::min()) * 1e6)
+    return "the quad's area " + show(area) + " is too small for single precision (at least " +
+           show(static_cast<double>(std::numeric_limits<float>::min()) * 1e6) + ")";
+  return {};
+}
 
 Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material) {
   Quad quad{};
   quad.q = q;
   quad.u = u;
   quad.v = v;
-  const Vec3 n = cross(u, v);
-  const float n2 = dot(n, n);
-  quad.area = std::sqrt(n2);
-  quad.normal = n * (1.0f / quad.area);
-  quad.plane_d = dot(quad.normal, q);
-  const Vec3 w = n * (1.0f / n2);
+  const DVec dq = dvec(q), du = dvec(u), dv = dvec(v);
+  const DVec n = dcross(du, dv);
+  const double n2 = ddot(n, n);
+  const double area = std::sqrt(n2);
+  const DVec unit_normal = dscale(n, 1.0 / area);
+  quad.area = static_cast<float>(area);
+  quad.normal = to_float(unit_normal);
+  quad.plane_d = static_cast<float>(ddot(unit_normal, dq));
+  const DVec w = dscale(n, 1.0 / n2);
   // p = q + a u + b v  =>  a = w . (rel x v) = rel . (v x w),  b = rel . (w x u)
-  quad.alpha_axis = cross(v, w);
-  quad.beta_axis = cross(w, u);
+  quad.alpha_axis = to_float(dcross(dv, w));
+  quad.beta_axis = to_float(dcross(w, du));
   quad.material = material;
   return quad;
 }

@@ -37,8 +37,13 @@ struct Sphere {
   std::uint32_t material;
 };
 
-// Builds a quad with its derived plane data. Throws nothing: callers validate u x v != 0.
+// Builds a quad with its derived plane data (computed in double). Throws
+// nothing: callers check quad_problem first.
 Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t material);
+// Empty when edges u and v make a quad whose plane data single precision can
+// hold; otherwise the true reason (an edge is zero, the edges are parallel, the
+// area overflows or underflows float).
+std::string quad_problem(const Vec3& u, const Vec3& v);
 
 // An object that the `light` techniques aim at (the book's `lights` list).
 struct Target {

@@ -202,9 +202,7 @@ Vec3 rotate_y(const Vec3& p, float cos_t, float sin_t) {
 }
 
 void check_quad(const Node& node, const Vec3& u, const Vec3& v) {
-  const Vec3 n = cross(u, v);
-  const float scale = length(u) * length(v);
-  if (!(scale > 0.0f) || !(length(n) > 1e-7f * scale)) node.fail("degenerate quad: u x v is zero (u and v are parallel or zero)");
+  if (const std::string problem = quad_problem(u, v); !problem.empty()) node.fail(problem);
 }
 
 void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& materials, Scene& scene) {
@@ -251,6 +249,7 @@ void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& 
         {{lo.x, lo.y, lo.z}, dx, dz},   // -y
     };
     for (const auto& f : faces) {
+      check_quad(node, f[1], f[2]);
       if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(scene.quads.size())});
       scene.quads.push_back(make_quad(rotate_y(f[0], c, s) + offset, rotate_y(f[1], c, s), rotate_y(f[2], c, s), mat));
     }
