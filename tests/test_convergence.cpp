@@ -233,3 +233,81 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
 
 }  // namespace
 }  // namespace pdflab
+
+namespace pdflab {
+namespace {
+
+// max_depth means the same for every strategy: a path has at most max_depth
+// segments, the camera ray included (max_depth 1: the lights seen directly;
+// 2: direct light; 3: one indirect bounce). Next-event estimation's shadow ray
+// is a segment too, so nee-mis must agree with the mixtures at every depth.
+TEST(Convergence, MaxDepthMeansTheSameForEveryStrategy) {
+  constexpr int kSmall = 24;
+  const char* strategies[] = {"cosine", "mix:cosine=0.5,light-sa=0.5", "nee-mis", "nee-mis:balance"};
+  const int tests = 3 * static_cast<int>(std::size(strategies)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
+  const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
+  std::uint64_t seed = 900;
+  for (const int depth : {1, 2, 3}) {
+    auto scene = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/small_light.json"));
+    scene->camera.width = kSmall;
+    scene->camera.height = kSmall;
+    scene->max_depth = depth;
+    scene->prepare();
+    const BlockImage reference = render_blocks("mix:cosine=0.5,light=0.5", seed++, 2048, scene);
+    for (const char* strategy : strategies) {
+      SCOPED_TRACE(std::string(strategy) + " at max_depth " + std::to_string(depth));
+      const std::uint32_t spp = std::string(strategy) == "cosine" ? 4096 : 512;
+      const Comparison cmp = compare(render_blocks(strategy, seed++, spp, scene), reference);
+      std::printf("[convergence] max_depth %d %-30s block z in [%+.2f, %+.2f] (limit %.2f)\n", depth, strategy,
+                  cmp.most_negative, cmp.most_positive, limit);
+      for (std::size_t i = 0; i < cmp.z.size(); ++i)
+        EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
+    }
+  }
+}
+
+// The book's box as it ships, scaled by 1e-3 and 1e4 and translated by 1e6:
+// radiance does not depend on the unit of length, so every strategy renders
+// the same image (within the block standard errors) at every scale.
+std::shared_ptr<Scene> transformed_book(float scale, float shift, int side) {
+  auto scene = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/cornell_book.json"));
+  const Vec3 t(shift, shift, shift);
+  for (Quad& q : scene->quads) q = make_quad(q.q * scale + t, q.u * scale, q.v * scale, q.material);
+  for (Sphere& s : scene->spheres) s = Sphere{s.center * scale + t, s.radius * scale, s.material};
+  scene->camera.lookfrom = scene->camera.lookfrom * scale + t;
+  scene->camera.lookat = scene->camera.lookat * scale + t;
+  scene->camera.width = side;
+  scene->camera.height = side;
+  scene->prepare();
+  return scene;
+}
+
+TEST(Convergence, BookBoxGivesTheSameImageAtEveryScaleAndPosition) {
+  constexpr int kSmall = 24;
+  struct Placement {
+    float scale, shift;
+  };
+  const Placement placements[] = {{1e-3f, 0.0f}, {1e4f, 0.0f}, {1.0f, 1e6f}};
+  const char* strategies[] = {"cosine", "mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light-sa=0.5", "nee-mis"};
+  const int tests = static_cast<int>(std::size(placements) * std::size(strategies)) * (kSmall / kBlock) *
+                    (kSmall / kBlock) * 3;
+  const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
+  std::uint64_t seed = 1300;
+  const auto unit_scene = transformed_book(1.0f, 0.0f, kSmall);
+  for (const char* strategy : strategies) {
+    const std::uint32_t spp = std::string(strategy) == "cosine" ? 2048 : 1024;
+    const BlockImage reference = render_blocks(strategy, seed++, spp, unit_scene);
+    for (const Placement& p : placements) {
+      SCOPED_TRACE(std::string(strategy) + " scale " + std::to_string(p.scale) + " shift " + std::to_string(p.shift));
+      const Comparison cmp = compare(render_blocks(strategy, seed++, spp, transformed_book(p.scale, p.shift, kSmall)),
+                                     reference);
+      std::printf("[convergence] scale %-6g shift %-6g %-30s block z in [%+.2f, %+.2f] (limit %.2f)\n", p.scale,
+                  p.shift, strategy, cmp.most_negative, cmp.most_positive, limit);
+      for (std::size_t i = 0; i < cmp.z.size(); ++i)
+        EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pdflab
