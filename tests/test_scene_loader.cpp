@@ -2,6 +2,7 @@
 // and every class of bad input is an InputError whose message points at the
 // offending JSON path (or line and column for syntax errors).
 #include "renderer/error.h"
+#include "renderer/sampling/leaf.h"
 #include "renderer/scene/scene_loader.h"
 
 #include <gtest/gtest.h>

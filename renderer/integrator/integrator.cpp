@@ -31,7 +31,7 @@ bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, boo
     const bool reflects = r.total_internal || r.reflectance > rng.uniform();
     dir = leaf::dielectric_direction(r, ray.direction, normal, reflects);
   }
-  ray = spawn_ray(hit.point, hit.normal, dir);
+  ray = spawn_ray(hit, dir);
   return true;
 }
 
@@ -73,10 +73,16 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       continue;
     }
 
-    // The light sample.
-    if (!plan.emitters.empty()) {
+    // Every ray leaving this vertex starts at `origin`, off the surface on the
+    // incoming ray's side: the light is sampled, and every pdf evaluated, from
+    // there, so a light smaller than the offset is aimed at exactly.
+    const Vec3 origin = diffuse_origin(hit, normal);
+
+    // The light sample. Its shadow ray is a path segment too: at the last
+    // vertex max_depth allows there is none (the path would have one too many).
+    if (!plan.emitters.empty() && depth + 1 < scene.max_depth) {
       const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-      const DirectionSample ls = plan.emitters.sample(hit.point, uc, u1, u2);
+      const DirectionSample ls = plan.emitters.sample(origin, uc, u1, u2);
       if (ls.none) {
         // Seen edge-on from here: no light sample, and the light pdf that the
         // material sample is weighed against is zero too.
@@ -85,7 +91,7 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       } else {
         const float cosine = dot(ls.direction, normal);
         Hit shadow_hit;
-        if (cosine > 0.0f && intersect(scene, spawn_ray(hit.point, hit.normal, ls.direction), kInf, shadow_hit)) {
+        if (cosine > 0.0f && intersect(scene, Ray{origin, ls.direction}, kInf, shadow_hit)) {
           const Material& lm = scene.materials[shadow_hit.material];
           if (lm.type == MaterialType::DiffuseLight && (dot(ls.direction, shadow_hit.normal) < 0.0f || lm.two_sided)) {
             const float bsdf_pdf = leaf::cosine_hemisphere_density(cosine);
@@ -101,9 +107,9 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
     if (!(ds.pdf > 0.0f)) break;  // exactly tangent: the estimate is zero
     throughput *= m.albedo;
     previous_pdf = ds.pdf;
-    previous_point = hit.point;
+    previous_point = origin;
     unweighted_emission = false;
-    ray = spawn_ray(hit.point, hit.normal, ds.direction);
+    ray = Ray{origin, ds.direction};
   }
   if (!is_finite(radiance)) {
     drops.add(DropReason::RadianceNotFinite);
@@ -133,7 +139,9 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
     }
 
     if (m.type == MaterialType::Lambertian) {
-      const DirectionSample ds = plan.sample(hit.point, normal, rng);
+      // Sampled, and its pdf evaluated, from the point the ray leaves from.
+      const Vec3 origin = diffuse_origin(hit, normal);
+      const DirectionSample ds = plan.sample(origin, normal, rng);
       if (ds.none) break;  // a light seen edge-on: a valid zero estimate
       if (!(ds.pdf > 0.0f)) {
         drops.add(std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
@@ -146,7 +154,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       const float cosine = dot(ds.direction, normal);
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
-      ray = spawn_ray(hit.point, hit.normal, ds.direction);
+      ray = Ray{origin, ds.direction};
     } else if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) {
       break;
     }

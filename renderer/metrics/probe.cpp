@@ -20,7 +20,7 @@ ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t see
     const Vec3 n = front ? hit.normal : -hit.normal;
     if (m.type == MaterialType::Lambertian) {
       at.found = true;
-      at.point = hit.point;
+      at.point = diffuse_origin(hit, n);  // where its rays leave from
       at.normal = n;
       at.material = hit.material;
       return at;
@@ -41,7 +41,7 @@ ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t see
       }
     }
     ++at.specular_bounces;
-    ray = spawn_ray(hit.point, hit.normal, dir);
+    ray = spawn_ray(hit, dir);
   }
   return at;
 }

@@ -37,6 +37,10 @@ PDFLAB_LEAF Float select(Mask m, Float a, Float b) { return m ? a : b; }
 PDFLAB_LEAF Int select(Mask m, Int a, Int b) { return m ? a : b; }
 PDFLAB_LEAF V3 select(Mask m, const V3& a, const V3& b) { return m ? a : b; }
 PDFLAB_LEAF Float lane_pow(Float x, float e) { return std::pow(x, e); }
+using Double = double;
+PDFLAB_LEAF Double to_double(Float x) { return x; }
+PDFLAB_LEAF Float to_float(Double x) { return static_cast<float>(x); }
+PDFLAB_LEAF Double lane_sqrt(Double x) { return std::sqrt(x); }
 // One path is one lane: lane 0, there when the mask is.
 template <class F>
 PDFLAB_LEAF void each_lane(Mask m, F f) {
@@ -61,9 +65,12 @@ using leaf::Onb;
 using leaf::sincos_2pi;
 using leaf::quad_hit_distance;
 
-// A new ray leaving `point` in `direction` (leaf::spawn_origin).
-inline Ray spawn_ray(const Vec3& point, const Vec3& geometric_normal, const Vec3& direction) {
-  return Ray{leaf::spawn_origin(point, geometric_normal, direction), direction};
+// A new ray leaving a hit in `direction` (leaf::spawn_origin).
+inline Ray spawn_ray(const Hit& hit, const Vec3& direction) {
+  return Ray{leaf::spawn_origin(hit.point, hit.normal, hit.error, direction), direction};
 }
+// Where every ray leaving a diffuse hit starts: off the surface on the side of
+// `facing`, the normal facing the incoming ray (leaf::offset_origin).
+inline Vec3 diffuse_origin(const Hit& hit, const Vec3& facing) { return leaf::offset_origin(hit.point, facing, hit.error); }
 
 }  // namespace pdflab

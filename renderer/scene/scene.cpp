@@ -197,6 +197,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     hit.point = ray.origin + ray.direction * closest;
     hit.normal = (hit.point - s.center) * (1.0f / s.radius);
     hit.material = s.material;
+    hit.error = leaf::sphere_hit_error(ray.origin, closest, hit.point);
     return true;
   }
   if (best_quad >= 0) {
@@ -205,6 +206,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     hit.point = ray.origin + ray.direction * closest;
     hit.normal = q.normal;
     hit.material = q.material;
+    hit.error = leaf::quad_hit_error(ray.origin, q.plane_d, closest);
     return true;
   }
   return false;

@@ -110,6 +110,10 @@ struct Hit {
   Vec3 point;
   Vec3 normal;  // geometric, outward (quads: u x v)
   std::uint32_t material;
+  // A bound on the distance between `point` (rounded) and the true surface,
+  // along the normal (leaf::quad_hit_error, leaf::sphere_hit_error): rays
+  // leaving the hit start this far off the surface.
+  float error;
 };
 
 // Closest intersection along the ray with t in (0, t_max). Origins are offset by
