@@ -91,7 +91,8 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       } else {
         const float cosine = dot(ls.direction, normal);
         Hit shadow_hit;
-        if (cosine > 0.0f && intersect(scene, Ray{origin, ls.direction}, kInf, shadow_hit)) {
+        if (cosine > 0.0f &&
+            intersect_aimed(scene, Ray{origin, ls.direction}, ls.aimed_quad, ls.aimed_distance, shadow_hit)) {
           const Material& lm = scene.materials[shadow_hit.material];
           if (lm.type == MaterialType::DiffuseLight && (dot(ls.direction, shadow_hit.normal) < 0.0f || lm.two_sided)) {
             const float bsdf_pdf = leaf::cosine_hemisphere_density(cosine);
@@ -122,9 +123,13 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
   if (plan.nee_mis) return trace_path_nee(scene, plan, ray, rng, drops);
   Vec3 radiance(0.0f);
   Vec3 throughput(1.0f);
+  int aimed_quad = -1;  // the quad the ray was aimed at (DirectionSample::aimed_quad)
+  float aimed_distance = 0.0f;
   for (int depth = 0; depth < scene.max_depth; ++depth) {
     Hit hit;
-    if (!intersect(scene, ray, kInf, hit)) {
+    const bool found = intersect_aimed(scene, ray, aimed_quad, aimed_distance, hit);
+    aimed_quad = -1;
+    if (!found) {
       radiance += throughput * scene.background;
       break;
     }
@@ -155,6 +160,8 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
       ray = Ray{origin, ds.direction};
+      aimed_quad = ds.aimed_quad;
+      aimed_distance = ds.aimed_distance;
     } else if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) {
       break;
     }

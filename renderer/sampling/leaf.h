@@ -51,6 +51,7 @@ PDFLAB_LEAF float lane_value(Float v, int) { return v; }
 PDFLAB_LEAF void set_lane_vec3(V3& v, int, const Vec3& x) { v = x; }
 PDFLAB_LEAF void set_lane_value(Float& v, int, float x) { v = x; }
 PDFLAB_LEAF void set_lane_mask(Mask& m, int, bool x) { m = x; }
+PDFLAB_LEAF void set_lane_int(Int& v, int, std::int32_t x) { v = x; }
 
 #include "renderer/sampling/leaf_math.inc"
 

@@ -263,6 +263,7 @@ DirectionSample TargetSet::sample(const Vec3& origin, float u_choice, float u1, 
     const QuadEntry& e = quads[chosen];
     ds = solid_angle ? sample_quad_solid_angle(*e.quad, origin, u1, u2) : sample_quad_area(*e.quad, origin, u1, u2);
     if (ds.none) return ds;
+    ds.aimed_quad = e.index;
     ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.quad);
   } else {
     const SphereEntry& e = spheres[chosen - nq];
@@ -281,7 +282,7 @@ std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pic
   for (std::size_t i = 0; i < scene.quads.size(); ++i) {
     const Quad& q = scene.quads[i];
     if (!pick(Target{Target::Kind::Quad, static_cast<std::uint32_t>(i)})) continue;
-    set.quads.push_back({&q, 0.0f});
+    set.quads.push_back({&q, 0.0f, static_cast<std::int32_t>(i)});
     quad_power.push_back(emitter_power(scene.materials[q.material], q.area));
   }
   for (std::size_t i = 0; i < scene.spheres.size(); ++i) {

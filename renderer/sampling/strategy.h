@@ -56,6 +56,7 @@ struct TargetSet {
   struct QuadEntry {
     const Quad* quad;
     float probability;
+    std::int32_t index;  // in Scene::quads (DirectionSample::aimed_quad)
   };
   struct SphereEntry {
     const Sphere* sphere;

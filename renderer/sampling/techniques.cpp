@@ -76,8 +76,9 @@ DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, fl
   const double yv = hv2 < 1.0 - 1e-12 ? (hv * dist) / std::sqrt(1.0 - hv2) : r.y1;
   const D3 local_dir = r.x * xu + r.y * std::clamp(yv, r.y0, r.y1) + r.z * r.z0;  // point - origin
   const D3 dir = dnormalize(local_dir);
+  const double distance = std::sqrt(local_dir.x * local_dir.x + local_dir.y * local_dir.y + local_dir.z * local_dir.z);
   return {Vec3(static_cast<float>(dir.x), static_cast<float>(dir.y), static_cast<float>(dir.z)),
-          static_cast<float>(1.0 / r.solid_angle)};
+          static_cast<float>(1.0 / r.solid_angle), false, -1, static_cast<float>(distance)};
 }
 
 float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {

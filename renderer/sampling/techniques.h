@@ -17,12 +17,17 @@ struct DirectionSample {
   // for every direction at this point, and the mixture or MIS estimator stays
   // unbiased when it contributes nothing.
   bool none = false;
+  // leaf::Sampled's aimed quad (-1: none) and the distance to the aimed point.
+  int aimed_quad = -1;
+  float aimed_distance = 0.0f;
 };
 
 // The formulas are leaf math (renderer/sampling/leaf_math.inc), shared with
 // the packet tracer; these are their one-path forms.
 
-inline DirectionSample to_direction_sample(const leaf::Sampled& s) { return {s.direction, s.pdf, s.none}; }
+inline DirectionSample to_direction_sample(const leaf::Sampled& s) {
+  return {s.direction, s.pdf, s.none, s.aimed_quad, s.aimed_distance};
+}
 
 // Cosine-weighted hemisphere: p(w) = cos(theta) / pi.
 inline DirectionSample sample_cosine_hemisphere(const Onb& frame, float u1, float u2) {

@@ -212,4 +212,16 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
   return false;
 }
 
+bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit) {
+  if (aimed_quad < 0) return intersect(scene, ray, kInf, hit);
+  if (intersect(scene, ray, distance * kAimedReach, hit)) return true;
+  const Quad& q = scene.quads[static_cast<std::size_t>(aimed_quad)];
+  hit.t = distance;
+  hit.point = ray.origin + ray.direction * distance;
+  hit.normal = q.normal;
+  hit.material = q.material;
+  hit.error = leaf::quad_hit_error(ray.origin, q.plane_d, distance);
+  return true;
+}
+
 }  // namespace pdflab

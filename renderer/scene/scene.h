@@ -119,5 +119,12 @@ struct Hit {
 // Closest intersection along the ray with t in (0, t_max). Origins are offset by
 // the caller (spawn_ray, renderer/sampling/leaf.h), so no t_min epsilon is needed here.
 bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit);
+// For a ray aimed at a point of quad `aimed_quad` (an index into Scene::quads,
+// or -1 for an ordinary ray) at `distance`: the nearest hit before a little
+// beyond that point, else the quad there. A sampled point of a quad is on it
+// even where float cannot aim a ray at it (a sliver, a quad nearly edge-on).
+bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit);
+// How far beyond the aimed point the search goes, relative to the distance.
+inline constexpr float kAimedReach = 1.0f + 0x1.0p-12f;
 
 }  // namespace pdflab
