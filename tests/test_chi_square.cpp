@@ -562,7 +562,8 @@ Outcome run_case(const ChiCase& c, std::uint64_t seed, Sampler which = Sampler::
     return run_chi_square(frame, PacketSampler(p.plan, p.origin, p.normal), density, outlines, seed);
   auto sampler = [&](Rng& rng) {
     if (!c.emitter_set) return p.plan.sample(p.origin, p.normal, rng);
-    const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+    const std::uint32_t uc = rng.next_u32();
+    const float u1 = rng.uniform(), u2 = rng.uniform();
     return p.plan.emitters.sample(p.origin, uc, u1, u2);
   };
   return run_chi_square(frame, sampler, density, outlines, seed);
@@ -659,7 +660,8 @@ TEST(ChiSquareHarness, RejectsSlightlyWrongLightPdf) {
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light"), scene);
   const Frame frame(n);
   auto sampler = [&](Rng& rng) {
-    const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+    const std::uint32_t u0 = rng.next_u32();
+    const float u1 = rng.uniform(), u2 = rng.uniform();
     return plan.book_targets.sample(origin, u0, u1, u2);
   };
   auto density = [&](const Vec3& d) { return static_cast<double>(quad_area_pdf(shifted, origin, d)); };
@@ -731,7 +733,8 @@ TEST(TargetChoice, ProportionalToPowerForLightSaUniformForLight) {
     const int n = 200000;
     int bright = 0, dim = 0;
     for (int i = 0; i < n; ++i) {
-      const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const std::uint32_t uc = rng.next_u32();
+      const float u1 = rng.uniform(), u2 = rng.uniform();
       const DirectionSample ds = set->sample(origin, uc, u1, u2);
       bright += quad_hit_distance(scene->quads[0], origin, ds.direction) > 0.0f;
       dim += quad_hit_distance(scene->quads[1], origin, ds.direction) > 0.0f;

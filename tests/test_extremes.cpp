@@ -120,7 +120,7 @@ TEST(Extremes, NextEventEstimationWithoutEmittersIsPlainCosineSampling) {
   auto scene = std::make_shared<Scene>(load_scene_text(text, "furnace.json"));
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("nee-mis"), *scene);
   EXPECT_TRUE(plan.emitters.empty());
-  EXPECT_TRUE(plan.emitters.sample(Vec3(0), 0.5f, 0.5f, 0.5f).none);
+  EXPECT_TRUE(plan.emitters.sample(Vec3(0), 0x80000000u, 0.5f, 0.5f).none);
   const Rendered r = render(scene, "nee-mis", 4);
   EXPECT_EQ(r.stats.dropped.total(), 0u);
   double m[3];

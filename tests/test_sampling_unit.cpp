@@ -3,6 +3,7 @@
 // and the mixture's technique selection. Distribution shape is the chi-square
 // suite's job; here every expectation is a number we can derive by hand.
 #include "renderer/error.h"
+#include "renderer/sampling/mixture.h"
 #include "renderer/sampling/onb.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/strategy.h"
@@ -341,7 +342,9 @@ TEST(SamplingPlan, NormalisesWeights) {
   float sum = 0.0f;
   for (float w : plan.weight) sum += w;
   EXPECT_FLOAT_EQ(sum, 1.0f);
-  EXPECT_EQ(plan.cdf[kTechniqueCount - 1], 1.0f);
+  // A quarter of the 2^32 numbers choose cosine, the rest light.
+  EXPECT_EQ(plan.choice_threshold[static_cast<int>(Technique::Cosine)], 0x40000000u);
+  EXPECT_EQ(plan.last_technique, static_cast<int>(Technique::Light));
 }
 
 TEST(SamplingPlan, MixturePdfIsTheWeightedSum) {
@@ -391,6 +394,64 @@ TEST(SamplingPlan, ZeroWeightTechniqueIsNeverSampled) {
   }
   // Half the samples come from the light technique: 10000 +- 4 sigma (sigma = 71).
   EXPECT_NEAR(down, kSamples / 2, 4 * 71);
+}
+
+// A weight of 1e-9 is chosen for exactly 4 of the 2^32 numbers, and the
+// mixture's pdf uses exactly that share: no bias however rare the technique.
+TEST(SamplingPlan, TinyWeightsAreRealisedExactlyOrRefused) {
+  const Scene scene = one_target_scene(false);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=1e-9,light=1"), scene);
+  constexpr int cosine = static_cast<int>(Technique::Cosine), light = static_cast<int>(Technique::Light);
+  EXPECT_EQ(plan.weight[cosine], static_cast<float>(4.0 * 0x1.0p-32));
+  EXPECT_EQ(plan.choice_threshold[cosine], 4u);
+  EXPECT_EQ(leaf::choose_technique(plan, 3), cosine);
+  EXPECT_EQ(leaf::choose_technique(plan, 4), light);
+  EXPECT_EQ(leaf::choose_technique(plan, -1), light);  // 2^32 - 1
+  // The mixture's pdf for a cosine direction carries exactly that weight.
+  const Vec3 origin(0.0f), normal(0, 1, 0), away = normalize(Vec3(1, 0.2f, 0));  // misses the light
+  EXPECT_FLOAT_EQ(plan.pdf(origin, normal, away), plan.weight[cosine] * cosine_hemisphere_pdf(normal, away));
+  // Below 2^-32 the sampler has no share to give: refused, naming the technique.
+  for (const char* text : {"mix:cosine=1e-45,light=1", "mix:light=1,uniform-hemisphere=1e-11"}) {
+    try {
+      (void)SamplingPlan::make(Strategy::parse(text), scene);
+      ADD_FAILURE() << text << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("below 2^-32"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::string(text).find("cosine") != std::string::npos ? "cosine" : "uniform-hemisphere"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+// A light a billion times dimmer than another is still chosen, as often as
+// its power says, whether it is listed first or last (a float CDF never
+// chose it when it came after the bright one).
+TEST(SamplingPlan, PowerRatiosOfABillionAreRealisedInEitherOrder) {
+  for (const bool dim_first : {true, false}) {
+    Scene scene;
+    scene.name = "two lamps";
+    Material bright, dim;
+    bright.type = dim.type = MaterialType::DiffuseLight;
+    bright.emit = Vec3(1e9f);
+    dim.emit = Vec3(1.0f);
+    scene.materials = dim_first ? std::vector<Material>{dim, bright} : std::vector<Material>{bright, dim};
+    scene.material_names = {"a", "b"};
+    scene.quads.push_back(make_quad(Vec3(-3.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));
+    scene.quads.push_back(make_quad(Vec3(2.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 1));
+    scene.targets = {{Target::Kind::Quad, 0}, {Target::Kind::Quad, 1}};
+    const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light-sa"), scene);
+    const int dim_index = dim_first ? 0 : 1;
+    const float p_dim = plan.power_targets.quads[static_cast<std::size_t>(dim_index)].probability;
+    EXPECT_NEAR(p_dim, 1e-9, 0x1.0p-32) << (dim_first ? "dim first" : "dim last");
+    // The numbers that choose the dim lamp: the first ones when it is listed
+    // first, the last ones otherwise; the direction then points at it.
+    const std::uint32_t u = dim_first ? 0u : 0xffffffffu;
+    const DirectionSample ds = plan.power_targets.sample(Vec3(0.0f), u, 0.5f, 0.5f);
+    EXPECT_EQ(ds.aimed_quad, dim_index);
+    EXPECT_EQ(ds.direction.x < 0.0f, dim_first);
+    EXPECT_GT(ds.pdf, 0.0f);
+  }
 }
 
 TEST(SamplingPlan, LightWithoutTargetsIsAnInputError) {

@@ -81,7 +81,8 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
     // The light sample. Its shadow ray is a path segment too: at the last
     // vertex max_depth allows there is none (the path would have one too many).
     if (!plan.emitters.empty() && depth + 1 < scene.max_depth) {
-      const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const std::uint32_t uc = rng.next_u32();
+      const float u1 = rng.uniform(), u2 = rng.uniform();
       const DirectionSample ls = plan.emitters.sample(origin, uc, u1, u2);
       if (ls.none) {
         // Seen edge-on from here: no light sample, and the light pdf that the

@@ -57,7 +57,9 @@ void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, st
 // direction, u_choice the target (used only by the techniques that draw one).
 struct PlanDraw {
   Vec3 point, normal;  // normal faces the incoming ray
-  float u0, u1, u2, u_choice;
+  std::uint32_t u0;  // the technique's 32 random bits
+  float u1, u2;
+  std::uint32_t u_choice;  // the target's
 };
 void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out);
 // The mixture's density for `directions[i]` at draws[i]'s point (its random numbers unused).

@@ -55,7 +55,8 @@ std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbeP
   for (int i = 0; i < count; ++i) {
     if (plan.nee_mis) {
       // nee-mis draws two directions at a vertex: one from the emitters...
-      const float uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const std::uint32_t uc = rng.next_u32();
+      const float u1 = rng.uniform(), u2 = rng.uniform();
       if (!plan.emitters.empty()) {
         const DirectionSample ls = plan.emitters.sample(at.point, uc, u1, u2);
         out.push_back({ls.direction, ls.pdf, ls.none ? -1 : static_cast<int>(Technique::LightSolidAngle)});

@@ -52,6 +52,7 @@ PDFLAB_LEAF void set_lane_vec3(V3& v, int, const Vec3& x) { v = x; }
 PDFLAB_LEAF void set_lane_value(Float& v, int, float x) { v = x; }
 PDFLAB_LEAF void set_lane_mask(Mask& m, int, bool x) { m = x; }
 PDFLAB_LEAF void set_lane_int(Int& v, int, std::int32_t x) { v = x; }
+PDFLAB_LEAF std::uint32_t lane_bits(Int v, int) { return static_cast<std::uint32_t>(v); }
 
 #include "renderer/sampling/leaf_math.inc"
 

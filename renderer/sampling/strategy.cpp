@@ -215,25 +215,14 @@ double emitter_power(const Material& m, double area) {
 }
 
 void TargetSet::set_probabilities(const std::vector<double>& weights) {
-  double total = 0.0;
-  for (double w : weights) total += w;
-  cdf.clear();
-  double running = 0.0;
-  std::size_t i = 0;
-  auto next = [&] {
-    const double p = weights[i++] / total;
-    running += p;
-    cdf.push_back(static_cast<float>(running));
-    return static_cast<float>(p);
-  };
-  for (auto& q : quads) q.probability = next();
-  for (auto& sp : spheres) sp.probability = next();
-  // Every u in [0, 1) must select a target; the last one with weight absorbs rounding.
-  for (std::size_t k = cdf.size(); k-- > 0;) {
-    const bool positive = k < quads.size() ? quads[k].probability > 0.0f : spheres[k - quads.size()].probability > 0.0f;
-    cdf[k] = 1.0f;
-    if (positive) break;
+  if (weights.empty()) {
+    choice = DiscreteDistribution();
+    return;
   }
+  choice = DiscreteDistribution(weights, DiscreteDistribution::Tiny::AtLeastOne);
+  int i = 0;
+  for (auto& q : quads) q.probability = choice.pmf(i++);
+  for (auto& sp : spheres) sp.probability = choice.pmf(i++);
 }
 
 float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const {
@@ -252,11 +241,9 @@ float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const vo
 
 float TargetSet::pdf(const Vec3& origin, const Vec3& direction) const { return pdf_without(origin, direction, nullptr); }
 
-DirectionSample TargetSet::sample(const Vec3& origin, float u_choice, float u1, float u2) const {
+DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const {
   if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at
-  int chosen = 0;
-  const int n = size();
-  while (chosen < n - 1 && u_choice >= cdf[chosen]) ++chosen;
+  const int chosen = choice.sample(u_choice);
   DirectionSample ds;
   const int nq = static_cast<int>(quads.size());
   if (chosen < nq) {
@@ -339,7 +326,7 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
 
   if (strategy.nee_mis) {
     plan.weight[static_cast<int>(Technique::Cosine)] = 1.0f;  // the material sample
-    plan.cdf.fill(1.0f);
+    plan.last_technique = static_cast<int>(Technique::Cosine);
     plan.uses_frame = true;
     return plan;
   }
@@ -356,35 +343,45 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   if (!(total > 0.0))
     throw InputError("strategy '" + strategy.to_string() + "' samples only the importance targets, but scene '" +
                      scene.name + "' has none");
-  double running = 0.0;
-  int last_positive = 0;
-  for (int i = 0; i < kTechniqueCount; ++i) {
-    plan.weight[i] = static_cast<float>(w[i] / total);
-    running += w[i] / total;
-    plan.cdf[i] = static_cast<float>(running);
-    if (w[i] > 0.0f) last_positive = i;
+  // The choice is made by a 32-bit number against thresholds fixed here, and
+  // the mixture's pdf uses the shares those thresholds realise: the sampler and
+  // the pdf agree exactly, for any weight down to 2^-32 of the total. A float
+  // compared with a float CDF realised 1e-9 as 0 or 2^-24 while the pdf divided
+  // by 1e-9 (an image 45 times too bright); below 2^-32 there is no share to give.
+  std::array<double, kTechniqueCount> wd{};
+  for (int i = 0; i < kTechniqueCount; ++i) wd[i] = w[i];
+  const DiscreteDistribution choice(wd, DiscreteDistribution::Tiny::Zero);
+  if (!choice.zero_positive().empty()) {
+    const int i = choice.zero_positive().front();
+    char share[32];
+    std::snprintf(share, sizeof share, "%.3g", wd[i] / total);
+    throw InputError("strategy '" + strategy.to_string() + "': " + std::string(kTable[i].name) + "'s share " + share +
+                     " of the weights is below 2^-32 (2.3e-10), the smallest probability the sampler can give a "
+                     "technique; use 0 or a larger weight");
   }
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    plan.weight[i] = choice.pmf(i);
+    plan.choice_threshold[i] = choice.thresholds()[static_cast<std::size_t>(i)];
+  }
+  plan.last_technique = choice.last_positive();
 #define PDFLAB_ROW(T) \
   plan.uses_frame = plan.uses_frame || (leaf::uses_frame<leaf::T>() && plan.weight[static_cast<int>(Technique::T)] > 0.0f);
   PDFLAB_TECHNIQUES(PDFLAB_ROW)
 #undef PDFLAB_ROW
-  // u < cdf[last_positive] must hold for every u in [0, 1); techniques after it
-  // have weight zero and must never be chosen.
-  for (int i = last_positive; i < kTechniqueCount; ++i) plan.cdf[i] = 1.0f;
   return plan;
 }
 
 float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const {
-  return leaf::mixture_pdf(*this, leaf::Shading(*this, origin, normal, 0.0f, 0.0f, 0.0f), direction, true);
+  return leaf::mixture_pdf(*this, leaf::Shading(*this, origin, normal, 0.0f, 0.0f, 0), direction, true);
 }
 
 DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
-  const float u0 = rng.uniform();
+  const auto u0 = static_cast<std::int32_t>(rng.next_u32());
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
-  const float u_choice = leaf::draws_target(*this, chosen) ? rng.uniform() : 0.0f;
+  const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(rng.next_u32()) : 0;
   return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
 }
 

@@ -3,6 +3,7 @@
 // diffuse bounce and with which weights, or next-event estimation with MIS.
 // A small value decided once per pass; nothing here allocates per ray.
 #include "renderer/math.h"
+#include "renderer/sampling/discrete.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/technique_table.h"
 #include "renderer/sampling/techniques.h"
@@ -64,18 +65,23 @@ struct TargetSet {
   };
   std::vector<QuadEntry> quads;
   std::vector<SphereEntry> spheres;
-  std::vector<float> cdf;  // over quads, then spheres
+  // Which target a 32-bit number chooses (over quads, then spheres); each
+  // entry's `probability` is exactly its realised share.
+  DiscreteDistribution choice;
   bool solid_angle = false;  // quads by spherical rectangle instead of by area
 
-  bool empty() const { return cdf.empty(); }
-  int size() const { return static_cast<int>(cdf.size()); }
-  // Probabilities proportional to `weights` (same order: quads, then spheres).
+  bool empty() const { return quads.empty() && spheres.empty(); }
+  int size() const { return static_cast<int>(quads.size() + spheres.size()); }
+  // Probabilities proportional to `weights` (same order: quads, then spheres),
+  // realised in multiples of 2^-32; a target with a positive weight below that
+  // keeps a share of 2^-32, so that it is still reached (a light 1e-12 as
+  // bright as another is still sampled, with the pdf saying how rarely).
   void set_probabilities(const std::vector<double>& weights);
 
-  // A direction towards one target (chosen with u_choice), its pdf being the
-  // set's: sum over targets of probability * per-target pdf. The chosen target's
-  // density comes from its sampler, the others' from evaluation.
-  DirectionSample sample(const Vec3& origin, float u_choice, float u1, float u2) const;
+  // A direction towards one target (chosen by the 32-bit number u_choice), its
+  // pdf being the set's: sum over targets of probability * per-target pdf. The
+  // chosen target's density comes from its sampler, the others' from evaluation.
+  DirectionSample sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const;
   float pdf(const Vec3& origin, const Vec3& direction) const;
 
  private:
@@ -86,8 +92,13 @@ struct TargetSet {
 // distribution, and the target sets. Built once per render; it points into the
 // scene, which must outlive it and stay where it is.
 struct SamplingPlan {
-  std::array<float, kTechniqueCount> weight{};  // normalised, sum to 1
-  std::array<float, kTechniqueCount> cdf{};     // cdf[i] = weight[0] + ... + weight[i]
+  // The realised probability of each technique (normalised weights in
+  // multiples of 2^-32): exactly how often the sampler chooses it.
+  std::array<float, kTechniqueCount> weight{};
+  // The choice by a 32-bit number (DiscreteDistribution::sample's form):
+  // technique = min(number of thresholds <= u, last_technique).
+  std::array<std::uint32_t, kTechniqueCount> choice_threshold{};
+  int last_technique = 0;
   std::array<float, kTechniqueCount> parameter{};  // Strategy::parameters
   bool uses_frame = false;  // a technique with weight draws in the shading frame
   const Scene* scene = nullptr;
@@ -100,7 +111,8 @@ struct SamplingPlan {
   int target_count = 0;     // importance targets
 
   // Throws InputError when the strategy needs targets the scene does not have
-  // and no other technique has weight.
+  // and no other technique has weight, or when a positive weight is below
+  // 2^-32 of the total (the sampler could not realise it).
   static SamplingPlan make(const Strategy& strategy, const Scene& scene);
 
   // Draws a direction from the mixture and returns it with the mixture's pdf
