@@ -536,7 +536,7 @@ class PacketSampler {
       std::vector<PlanDraw> draws(kBatch);
       for (PlanDraw& d : draws) {
         d.point = origin_, d.normal = normal_;
-        d.u0 = rng.uniform(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.uniform();
+        d.u0 = rng.next_u32(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.next_u32();
       }
       batch_.resize(kBatch);
       sample_plan(best_packet_isa(), plan_, draws.data(), draws.size(), batch_.data());

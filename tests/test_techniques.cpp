@@ -41,7 +41,7 @@ std::vector<PlanDraw> draws(std::size_t n, std::uint64_t seed) {
   for (PlanDraw& d : out) {
     d.point = Vec3(555.0f * rng.uniform(), 555.0f * rng.uniform(), 555.0f * rng.uniform());
     d.normal = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
-    d.u0 = rng.uniform(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.uniform();
+    d.u0 = rng.next_u32(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.next_u32();
   }
   return out;
 }
@@ -52,8 +52,8 @@ bool same_bits(const DirectionSample& a, const DirectionSample& b) {
 }
 
 DirectionSample one_path(const SamplingPlan& plan, const PlanDraw& d) {
-  const int chosen = leaf::choose_technique(plan, d.u0);
-  const leaf::Shading at(plan, d.point, d.normal, d.u1, d.u2, d.u_choice);
+  const int chosen = leaf::choose_technique(plan, static_cast<std::int32_t>(d.u0));
+  const leaf::Shading at(plan, d.point, d.normal, d.u1, d.u2, static_cast<std::int32_t>(d.u_choice));
   return to_direction_sample(leaf::sample_mixture(plan, at, chosen, true));
 }
 
