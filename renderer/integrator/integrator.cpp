@@ -120,13 +120,16 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
   return radiance;
 }
 
-Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
+Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops,
+                PathRecord* record) {
   if (plan.nee_mis) return trace_path_nee(scene, plan, ray, rng, drops);
   Vec3 radiance(0.0f);
   Vec3 throughput(1.0f);
   int aimed_quad = -1;  // the quad the ray was aimed at (DirectionSample::aimed_quad)
   float aimed_distance = 0.0f;
+  if (record) record->vertices.clear(), record->segments = 0;
   for (int depth = 0; depth < scene.max_depth; ++depth) {
+    if (record) ++record->segments;
     Hit hit;
     const bool found = intersect_aimed(scene, ray, aimed_quad, aimed_distance, hit);
     aimed_quad = -1;
@@ -157,6 +160,9 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
         drops.add(DropReason::PdfNotFinite);
         break;
       }
+      // Drawn with the mixture's density, whatever becomes of it: a direction
+      // below the surface ends the path, with a probability that depends on the weights.
+      if (record) record->vertices.push_back({hit.point, normal, ds.direction});
       const float cosine = dot(ds.direction, normal);
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace pdflab {
 
@@ -45,8 +46,22 @@ inline std::uint8_t drop_reason_bits(const DropCounts& before, const DropCounts&
   return bits;
 }
 
-// Radiance along one camera ray. Returns zero (and counts) when the estimate is not finite.
-Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops);
+// What the mixture-weight predictor needs of a path (renderer/metrics/weight_paths.h):
+// each diffuse vertex's point, normal (facing the arriving ray) and the direction
+// the mixture drew there, and how many rays the path traced.
+struct PathRecord {
+  struct Vertex {
+    Vec3 point, normal, direction;
+  };
+  std::vector<Vertex> vertices;
+  int segments = 0;
+};
+
+// Radiance along one camera ray. Returns zero (and counts) when the estimate is
+// not finite. With `record` (mixtures only), also what the path did; its
+// vector keeps its capacity from path to path.
+Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops,
+                PathRecord* record = nullptr);
 
 // The camera ray and the random stream of one pixel sample.
 struct PixelSampleStart {
