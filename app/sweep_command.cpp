@@ -5,6 +5,8 @@
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/metrics/svg_plot.h"
+#include "renderer/metrics/weight_paths.h"
+#include "renderer/metrics/weight_prediction.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
@@ -95,6 +97,18 @@ struct Family {
       text += buf;
     }
     return Strategy::parse(text);
+  }
+  MixtureFamily mixture_family() const {
+    MixtureFamily m;
+    m.a = Strategy::parse(a);
+    m.b = Strategy::parse(b);
+    m.share = rest.empty() ? 1.0 : share;
+    if (!rest.empty()) {
+      std::string text = "mix:";
+      for (const auto& [name, weight] : rest) text += (text.size() > 4 ? "," : "") + name + "=" + std::to_string(weight);
+      m.rest = Strategy::parse(text);
+    }
+    return m;
   }
 };
 
@@ -208,7 +222,11 @@ struct Row {
   bool unbiased = true;
   std::uint32_t spp = 0;  // the first seed's
   Interval seconds, relmse, efficiency, samples_per_second;
+  Interval predicted;  // efficiency predicted from the pilot weight's runs
 };
+
+// Samples per pixel replayed for the prediction: the pilot run's first ones.
+constexpr std::uint32_t kPredictionSpp = 256;
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "";
@@ -248,6 +266,21 @@ int run_sweep(const SweepOptions& o) {
   const Reference reference =
       comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height}, strategies, seeds, o.quiet);
 
+  // The prediction replays the paths of the runs at one weight, the pilot: the
+  // row nearest 0.5 that lies inside the defensive floor (see
+  // weight_prediction.h). It predicts on the rows' weights and a fine grid.
+  int pilot = -1;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (defended_weight(rows[i].weight) == rows[i].weight &&
+        (pilot < 0 || std::fabs(rows[i].weight - 0.5) < std::fabs(rows[static_cast<std::size_t>(pilot)].weight - 0.5)))
+      pilot = static_cast<int>(i);
+  std::vector<double> grid = weight_grid(101);
+  grid.insert(grid.end(), weights.begin(), weights.end());
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  const MixtureFamily mixture_family = family.mixture_family();
+  std::vector<WeightPrediction> predictions;  // one per seed of the pilot
+
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const bool show_progress = !o.quiet && tty;
   const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
@@ -261,6 +294,14 @@ int run_sweep(const SweepOptions& o) {
       const Run run = render_once(scene, r.strategy, seeds[static_cast<std::size_t>(k)], o, reference, label,
                                   show_progress);
       if (k == 0) r.spp = run.spp;
+      if (&r == &rows[static_cast<std::size_t>(std::max(pilot, 0))] && pilot >= 0 && run.spp > 0) {
+        WeightPathOptions po;
+        po.seed = seeds[static_cast<std::size_t>(k)];
+        po.samples = std::min(run.spp, kPredictionSpp);
+        po.threads = o.threads;
+        const WeightPredictor predictor = record_weight_paths(*scene, mixture_family, r.strategy, r.weight, grid, po);
+        predictions.push_back(predictor.predict(reference.rgb, run.seconds / run.spp, kRelMseEpsilon));
+      }
       seconds.push_back(run.seconds);
       rel.push_back(run.relmse);
       eff.push_back(run.efficiency);
@@ -297,12 +338,31 @@ int run_sweep(const SweepOptions& o) {
   }
   const double best_efficiency = best >= 0 ? rows[static_cast<std::size_t>(best)].efficiency.mean : 0.0;
 
-  // The predicted columns stay empty: predicting needs every technique's pdf at
-  // each path vertex, which the tracers do not record yet.
+  // The prediction on each row's weight and on the fine grid, over the pilot's seeds.
+  auto grid_index = [&](double w) {
+    return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
+  };
+  std::vector<double> predicted_curve(grid.size(), 0.0), predicted_best;
+  for (const WeightPrediction& p : predictions) {
+    for (std::size_t g = 0; g < grid.size(); ++g) predicted_curve[g] += p.efficiency[g] / static_cast<double>(predictions.size());
+    if (p.best >= 0) predicted_best.push_back(p.best_weight());
+  }
+  double predicted_max_row = 0.0;
+  for (Row& r : rows) {
+    if (predictions.empty()) {
+      r.predicted.mean = std::nan("");
+      continue;
+    }
+    std::vector<double> values;
+    for (const WeightPrediction& p : predictions) values.push_back(p.efficiency[grid_index(r.weight)]);
+    r.predicted = interval(values);
+    if (r.unbiased) predicted_max_row = std::max(predicted_max_row, r.predicted.mean);
+  }
+  const Interval predicted_optimum = interval(predicted_best);
   std::string csv =
       "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
       "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
-      "predicted_relative_efficiency,best,in_best_interval\n";
+      "predicted_efficiency_lo,predicted_efficiency_hi,predicted_relative_efficiency,best,in_best_interval\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const int idx = static_cast<int>(i);
@@ -312,7 +372,10 @@ int run_sweep(const SweepOptions& o) {
            "," + num(r.efficiency.lo()) + "," + num(r.efficiency.hi()) + "," +
            num(best_efficiency > 0 ? r.efficiency.mean / best_efficiency : std::nan("")) + "," +
            num(r.samples_per_second.mean) + "," + num(r.samples_per_second.lo()) + "," +
-           num(r.samples_per_second.hi()) + ",,," + (idx == best ? "1" : "0") + "," +
+           num(r.samples_per_second.hi()) + "," + num(r.predicted.mean) + "," + num(r.predicted.lo()) + "," +
+           num(r.predicted.hi()) + "," +
+           num(predicted_max_row > 0 && r.unbiased ? r.predicted.mean / predicted_max_row : std::nan("")) + "," +
+           (idx == best ? "1" : "0") + "," +
            (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "\n";
   }
 
@@ -343,20 +406,33 @@ int run_sweep(const SweepOptions& o) {
       std::snprintf(buf, sizeof buf, "best %.3g (band %.3g..%.3g)", po.marker_x, po.marker_lo, po.marker_hi);
       po.marker_label = buf;
     }
-    plot = linear_svg({measured}, po);
+    std::vector<PlotSeries> series = {measured};
+    if (!predictions.empty()) {
+      PlotSeries predicted;
+      char buf[128];
+      std::snprintf(buf, sizeof buf, "predicted from w = %.3g (best %.3g)", rows[static_cast<std::size_t>(pilot)].weight,
+                    predicted_optimum.mean);
+      predicted.label = buf;
+      predicted.dashed = true;
+      for (std::size_t g = 0; g < grid.size(); ++g)
+        if (grid[g] >= weights.front() && grid[g] <= weights.back() && predicted_curve[g] > 0.0)
+          predicted.x.push_back(grid[g]), predicted.y.push_back(predicted_curve[g]);
+      series.push_back(predicted);
+    }
+    plot = linear_svg(series, po);
   }
   write_file_atomic(o.csv, {reinterpret_cast<const std::uint8_t*>(csv.data()), csv.size()});
   if (!o.plot.empty()) write_file_atomic(o.plot, {reinterpret_cast<const std::uint8_t*>(plot.data()), plot.size()});
 
-  std::printf("%-8s %-40s %6s %10s %22s %10s %9s\n", "weight", "strategy", "spp", "relmse", "efficiency (95%)",
-              "vs best", "Msamp/s");
+  std::printf("%-8s %-40s %6s %10s %22s %10s %11s %9s\n", "weight", "strategy", "spp", "relmse", "efficiency (95%)",
+              "vs best", "predicted", "Msamp/s");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     char eff[64];
     std::snprintf(eff, sizeof eff, "%.4g +- %.2g", r.efficiency.mean, r.efficiency.half);
-    std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(), r.spp,
-                r.relmse.mean, eff, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
-                r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
+    std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %11.4g %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(),
+                r.spp, r.relmse.mean, eff, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
+                r.predicted.mean, r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
                 static_cast<int>(i) == best ? "  <- best" : "");
   }
   if (best >= 0)
@@ -365,6 +441,13 @@ int run_sweep(const SweepOptions& o) {
                 rows[static_cast<std::size_t>(band_hi)].weight);
   else
     std::printf("no weight of the sweep gives an unbiased mixture\n");
+  if (!predictions.empty())
+    std::printf("predicted best weight (from the paths at %.3g, %zu seeds): %.3g +- %.2g\n",
+                rows[static_cast<std::size_t>(pilot)].weight, predictions.size(), predicted_optimum.mean,
+                predicted_optimum.half);
+  else
+    std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
+                1.0 - kDefensiveFloor);
   return 0;
 }
 

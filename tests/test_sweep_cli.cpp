@@ -168,6 +168,12 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
     EXPECT_LE(number(rows[i], "efficiency_lo"), number(rows[i], "efficiency"));
     EXPECT_GE(number(rows[i], "efficiency_hi"), number(rows[i], "efficiency"));
     if (rows[i].at("best") == "1") best = static_cast<int>(i), ++bests;
+    // Predicted from the paths at 0.5: positive for every unbiased mixture.
+    if (i > 0) {
+      EXPECT_GT(number(rows[i], "predicted_efficiency"), 0.0) << i;
+      EXPECT_LE(number(rows[i], "predicted_efficiency_lo"), number(rows[i], "predicted_efficiency"));
+      EXPECT_LE(number(rows[i], "predicted_relative_efficiency"), 1.0);
+    }
   }
   EXPECT_EQ(rows[0].at("strategy"), "light");
   EXPECT_EQ(rows[0].at("unbiased"), "0");  // light alone misses indirect light
@@ -201,6 +207,8 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
   EXPECT_NE(svg.find("best " + std::string(best == 1 ? "0.25" : best == 2 ? "0.5" : best == 3 ? "0.75" : "1")),
             std::string::npos);
   EXPECT_NE(svg.find("weight of cosine"), std::string::npos);
+  EXPECT_NE(svg.find("predicted from w = 0.5"), std::string::npos);
+  EXPECT_NE(r.out.find("predicted best weight"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ struct WeightPrediction {
   std::vector<double> weight;           // the grid
   std::vector<double> relative_variance;  // mean over pixels and channels of var / (mu^2 + eps), one sample each
   std::vector<double> cost;             // expected cost of a path (segments traced)
-  std::vector<double> efficiency;       // 1 / (relative_variance * seconds per sample); 0 where infinite variance
+  std::vector<double> efficiency;       // 1 / (relative_variance * seconds per pass); 0 where infinite variance
   std::uint64_t paths = 0;
   int best = -1;                        // index of the highest efficiency; -1 when none is finite
   double best_weight() const { return best >= 0 ? weight[static_cast<std::size_t>(best)] : -1.0; }
@@ -87,8 +87,9 @@ class WeightPredictor {
   // The prediction. `mean_rgb` holds each cell's mean (from a reference or the
   // film, 3 floats a cell; for a block cell, `mean_square_rgb` may give the
   // block's mean of mu^2 per channel, otherwise mean_rgb^2 is used).
-  // `seconds_per_sample` is the measured time per path at the sampling weight
-  // (0: efficiency in units of 1 / (relative variance * cost)). `cost_offset`
+  // `seconds_per_sample` is the measured time of one sample in every cell (one
+  // pass of 1 spp) at the sampling weight, so that the efficiency is a render's
+  // 1 / (relMSE * seconds); 0: efficiency in units of 1 / (relative variance * cost). `cost_offset`
   // is the per-path cost that does not scale with the path's length.
   WeightPrediction predict(const std::vector<float>& mean_rgb, double seconds_per_sample, double epsilon,
                            double cost_offset = 0.0, const std::vector<float>* mean_square_rgb = nullptr) const;

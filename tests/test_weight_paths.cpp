@@ -1,0 +1,110 @@
+// The weight predictor fed by real paths (renderer/metrics/weight_paths.h): the
+// tracer's record does not change a path, and the second moment predicted at
+// one weight from paths drawn at another equals the one measured from paths
+// drawn at that weight, on the book's box.
+#include "renderer/integrator/integrator.h"
+#include "renderer/metrics/weight_paths.h"
+#include "renderer/scene/scene_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace {
+
+using namespace pdflab;
+
+// Short paths keep the second moments finite and their estimates tame: with
+// depth 50 a small cosine share makes the moment grow geometrically with depth
+// (about albedo^2 / w a bounce), and no finite run measures it well.
+Scene small_box(int size, int depth = 4) {
+  Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  scene.max_depth = depth;
+  scene.camera.width = size;
+  scene.camera.height = size;
+  scene.prepare();
+  return scene;
+}
+
+MixtureFamily cosine_light() {
+  MixtureFamily f;
+  f.a = Strategy::parse("cosine");
+  f.b = Strategy::parse("light");
+  return f;
+}
+
+TEST(WeightPaths, RecordingLeavesThePathAlone) {
+  const Scene scene = small_box(8);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), scene);
+  const SampleSeed seed(3);
+  PathRecord record;
+  int with_vertices = 0;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (std::uint32_t i = 0; i < 8; ++i) {
+        PixelSampleStart a = begin_pixel_sample(scene, seed, x, y, i), b = a;
+        DropCounts da, db;
+        const Vec3 plain = trace_path(scene, plan, a.ray, a.rng, da);
+        const Vec3 recorded = trace_path(scene, plan, b.ray, b.rng, db, &record);
+        EXPECT_EQ(std::memcmp(&plain, &recorded, sizeof plain), 0);
+        EXPECT_GE(record.segments, 1);
+        EXPECT_LE(static_cast<int>(record.vertices.size()), record.segments);
+        with_vertices += record.vertices.empty() ? 0 : 1;
+        for (const PathRecord::Vertex& v : record.vertices)
+          EXPECT_GT(plan.pdf(v.point, v.normal, v.direction), 0.0f);
+      }
+  EXPECT_GT(with_vertices, 8 * 8 * 8 / 2);
+}
+
+// Image-wide second moment relative to the reference, one number per weight.
+double image_moment(const WeightPredictor& p, std::size_t g, const std::vector<float>& mean) {
+  double sum = 0.0;
+  for (int cell = 0; cell < static_cast<int>(mean.size() / 3); ++cell)
+    for (int c = 0; c < 3; ++c) {
+      const double mu = mean[static_cast<std::size_t>(cell) * 3 + static_cast<std::size_t>(c)];
+      sum += p.second_moment(cell, g, c) / (mu * mu + 0.01);
+    }
+  return sum / static_cast<double>(mean.size());
+}
+
+TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
+  const Scene scene = small_box(12);
+  const MixtureFamily family = cosine_light();
+  WeightPathOptions o;
+  o.samples = 512;
+  o.threads = 2;
+  // The mean per pixel: from many paths at 0.5 (it does not depend on the weight).
+  const std::vector<double> grid = {0.25, 0.5, 0.8};
+  o.seed = 11;
+  const WeightPredictor drawn_half = record_weight_paths(scene, family, Strategy::parse("mix:cosine=0.5,light=0.5"),
+                                                         0.5, grid, o);
+  std::vector<float> mean(static_cast<std::size_t>(12 * 12 * 3), 0.0f);
+  // Mean image from a render of the same scene.
+  {
+    const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), scene);
+    DropCounts drops;
+    for (int y = 0; y < 12; ++y)
+      for (int x = 0; x < 12; ++x) {
+        Vec3 sum(0.0f);
+        for (std::uint32_t i = 0; i < 1024; ++i) sum += render_pixel_sample(scene, plan, 99, x, y, i, drops);
+        const std::size_t k = static_cast<std::size_t>(y * 12 + x) * 3;
+        mean[k] = sum.x / 1024, mean[k + 1] = sum.y / 1024, mean[k + 2] = sum.z / 1024;
+      }
+  }
+  for (double w : {0.25, 0.8}) {
+    o.seed = 21;
+    char text[64];
+    std::snprintf(text, sizeof text, "mix:cosine=%g,light=%g", w, 1.0 - w);
+    const WeightPredictor drawn_there = record_weight_paths(scene, family, Strategy::parse(text), w, grid, o);
+    const std::size_t g = w < 0.5 ? 0 : 2;
+    const double predicted = image_moment(drawn_half, g, mean);
+    const double measured = image_moment(drawn_there, g, mean);
+    EXPECT_NEAR(predicted, measured, 0.1 * measured) << "at " << w;
+    // And the difference between weights is real, so the test can tell them apart.
+    EXPECT_GT(std::fabs(image_moment(drawn_half, 1, mean) - measured), 0.1 * measured) << "at " << w;
+  }
+}
+
+}  // namespace
