@@ -208,6 +208,8 @@ int main(int argc, char** argv) {
   sweep->add_option("--plot", so.plot, "Efficiency against weight, best weight marked (SVG)");
   sweep->add_option("--threads", so.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   sweep->add_flag("--quiet", so.quiet, "No progress");
+  sweep->add_flag("--auto", so.auto_weight,
+                  "Also render with auto weight (chosen between passes from the prediction) and compare");
 
   try {
     app.parse(argc, argv);

@@ -27,6 +27,8 @@ namespace pdflab {
 namespace {
 
 constexpr int kMaxWeights = 201;
+// Auto weight's passes use seeds this far apart from the sweep's.
+constexpr std::uint64_t kAutoSeedStride = 1000;
 
 std::string trim(std::string s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.erase(s.begin());
@@ -182,7 +184,7 @@ struct Run {
 
 Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                 const SweepOptions& o, const Reference& reference, const std::string& label,
-                bool show_progress) {
+                bool show_progress, std::vector<float>* image = nullptr) {
   RenderSession session(o.threads);
   RenderSettings settings;
   settings.scene = scene;
@@ -210,10 +212,64 @@ Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strat
   r.spp = st.spp;
   r.seconds = st.seconds;
   // Corrected for the reference's own noise when it has a variance (as bench does).
-  r.relmse = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance).corrected;
+  const std::vector<float> mean = film.mean_rgb();
+  r.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
+  if (image) *image = mean;
   r.efficiency = efficiency(r.relmse, r.seconds);
   r.samples_per_second = st.samples_per_second;
   return r;
+}
+
+// Auto weight (weight_paths.h): the run is split into passes of 1/8, 1/8, 1/4
+// and 1/2 of the time (or spp); each pass renders at the weight the passes
+// before it predicted best, starting at 0.5, and the image is their
+// sample-weighted mean. Its time includes replaying paths for the prediction.
+struct AutoRun {
+  Run run;
+  std::vector<double> weights;  // per pass
+};
+
+AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const Family& family, const MixtureFamily& mixtures,
+                    std::uint64_t seed, const SweepOptions& o, const Reference& reference, const std::string& label,
+                    bool show_progress) {
+  constexpr double kShare[4] = {0.125, 0.125, 0.25, 0.5};
+  // Few replayed samples and a coarse grid: the replay's time counts against auto weight.
+  constexpr std::uint32_t kReplaySpp = 4;
+  AutoWeight chooser(0.5, 21);
+  const std::size_t values = reference.rgb.size();
+  std::vector<double> sum(values, 0.0);
+  AutoRun out;
+  double seconds = 0.0;
+  std::uint32_t spp = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    const double w = chooser.weight();
+    out.weights.push_back(w);
+    SweepOptions slice = o;
+    slice.seconds = o.seconds * kShare[pass];
+    slice.spp = o.spp > 0 ? std::max<std::uint32_t>(1, static_cast<std::uint32_t>(o.spp * kShare[pass])) : 0;
+    const std::uint64_t pass_seed = seed + kAutoSeedStride * static_cast<std::uint64_t>(pass + 1);
+    std::vector<float> image;
+    const Run r = render_once(scene, family.at(w), pass_seed, slice, reference, label, show_progress, &image);
+    for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(image[i]) * r.spp;
+    spp += r.spp;
+    seconds += r.seconds;
+    if (pass == 3 || r.spp == 0) continue;
+    const auto start = std::chrono::steady_clock::now();
+    WeightPathOptions po;
+    po.seed = pass_seed;
+    po.samples = std::min(r.spp, kReplaySpp);
+    po.threads = o.threads;
+    const WeightPredictor predictor = record_weight_paths(*scene, mixtures, family.at(w), w, chooser.grid(), po);
+    chooser.add_pass(predictor.predict(reference.rgb, r.seconds / r.spp, kRelMseEpsilon));
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  std::vector<float> mean(values);
+  for (std::size_t i = 0; i < values; ++i) mean[i] = spp > 0 ? static_cast<float>(sum[i] / spp) : 0.0f;
+  out.run.spp = spp;
+  out.run.seconds = seconds;
+  out.run.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
+  out.run.efficiency = efficiency(out.run.relmse, seconds);
+  return out;
 }
 
 struct Row {
@@ -263,6 +319,9 @@ int run_sweep(const SweepOptions& o) {
   for (int k = 0; k < o.seeds; ++k) seeds.push_back(o.seed + static_cast<std::uint64_t>(k));
   std::vector<Strategy> strategies;
   for (const Row& r : rows) strategies.push_back(r.strategy);
+  if (o.auto_weight)
+    for (int k = 0; k < o.seeds; ++k)
+      for (std::uint64_t pass = 1; pass <= 4; ++pass) seeds.push_back(seeds[static_cast<std::size_t>(k)] + kAutoSeedStride * pass);
   const Reference reference =
       comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height}, strategies, seeds, o.quiet);
 
@@ -314,6 +373,27 @@ int run_sweep(const SweepOptions& o) {
     r.relmse = interval(rel);
     r.efficiency = interval(eff);
     r.samples_per_second = interval(sps);
+  }
+  Interval auto_efficiency, auto_relmse, auto_seconds;
+  std::vector<std::vector<double>> auto_weights;
+  if (o.auto_weight) {
+    std::vector<double> eff, rel, sec;
+    for (int k = 0; k < o.seeds; ++k) {
+      char label[64];
+      std::snprintf(label, sizeof label, "[auto] seed %d/%d", k + 1, o.seeds);
+      const AutoRun a = render_auto(scene, family, mixture_family, seeds[static_cast<std::size_t>(k)], o, reference,
+                                    label, show_progress);
+      eff.push_back(a.run.efficiency);
+      rel.push_back(a.run.relmse);
+      sec.push_back(a.run.seconds);
+      auto_weights.push_back(a.weights);
+      if (!o.quiet && !tty)
+        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, a.run.spp, a.run.seconds,
+                     a.run.relmse, a.run.efficiency);
+    }
+    auto_efficiency = interval(eff);
+    auto_relmse = interval(rel);
+    auto_seconds = interval(sec);
   }
   if (show_progress) std::fputc('\n', stderr);
 
@@ -379,6 +459,15 @@ int run_sweep(const SweepOptions& o) {
            (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "\n";
   }
 
+  if (o.auto_weight) {
+    std::string history;
+    for (double w : auto_weights[0]) history += (history.empty() ? "" : ">") + num(w);
+    csv += num(auto_weights[0].back()) + ",\"auto:" + history + "\",1," + std::to_string(o.seeds) + ",," +
+           num(auto_seconds.mean) + "," + num(auto_relmse.mean) + "," + num(auto_relmse.lo()) + "," +
+           num(auto_relmse.hi()) + "," + num(auto_efficiency.mean) + "," + num(auto_efficiency.lo()) + "," +
+           num(auto_efficiency.hi()) + "," +
+           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0\n";
+  }
   std::string plot;
   if (!o.plot.empty()) {
     PlotSeries measured;
@@ -441,6 +530,16 @@ int run_sweep(const SweepOptions& o) {
                 rows[static_cast<std::size_t>(band_hi)].weight);
   else
     std::printf("no weight of the sweep gives an unbiased mixture\n");
+  if (o.auto_weight) {
+    std::printf("auto weight: efficiency %.4g +- %.2g, %.0f%% of the best fixed weight's; weights per pass:",
+                auto_efficiency.mean, auto_efficiency.half,
+                best_efficiency > 0 ? 100.0 * auto_efficiency.mean / best_efficiency : 0.0);
+    for (const auto& h : auto_weights) {
+      std::printf(" ");
+      for (std::size_t i = 0; i < h.size(); ++i) std::printf("%s%.3g", i ? ">" : "", h[i]);
+    }
+    std::printf("\n");
+  }
   if (!predictions.empty())
     std::printf("predicted best weight (from the paths at %.3g, %zu seeds): %.3g +- %.2g\n",
                 rows[static_cast<std::size_t>(pilot)].weight, predictions.size(), predicted_optimum.mean,

@@ -20,6 +20,8 @@ struct SweepOptions {
   std::string plot;       // SVG, optional
   int threads = 0;
   bool quiet = false;
+  bool auto_weight = false;  // also render with the weight chosen between passes
+
 };
 
 // Runs `pdflab sweep`. Returns the exit status; throws InputError for bad input.

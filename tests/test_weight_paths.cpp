@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -105,6 +106,71 @@ TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
     // And the difference between weights is real, so the test can tell them apart.
     EXPECT_GT(std::fabs(image_moment(drawn_half, 1, mean) - measured), 0.1 * measured) << "at " << w;
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Auto weight: passes whose weights come from earlier passes' predictions sum
+// to the same image as a fixed weight (a chi-square over pixels and channels of
+// the difference in units of its standard error), and the weight did move.
+TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
+  const Scene scene = small_box(8);
+  const MixtureFamily family = cosine_light();
+  const std::size_t pixels = 64;
+
+  Film automatic(8, 8);
+  // Start far from this box's best weight (about 0.5 at depth 4).
+  AutoWeight chooser(0.15, 21);
+  WeightPathOptions o;
+  o.threads = 2;
+  o.film = &automatic;
+  o.samples = 512;
+  for (int pass = 0; pass < 4; ++pass) {
+    const double w = chooser.weight();
+    char text[64];
+    std::snprintf(text, sizeof text, "mix:cosine=%.9g,light=%.9g", w, 1.0 - w);
+    o.seed = 100 + static_cast<std::uint64_t>(pass);
+    const WeightPredictor p = record_weight_paths(scene, family, Strategy::parse(text), w, chooser.grid(), o);
+    // The pass's own mean as mu: what a render knows (no reference).
+    std::vector<float> mean;
+    automatic.mean_rgb(mean);
+    chooser.add_pass(p.predict(mean, 0.0, 0.01));
+  }
+  ASSERT_EQ(chooser.history().size(), 5u);
+  EXPECT_GT(chooser.history()[1], 0.3) << "the prediction did not move the weight";
+  EXPECT_GT(chooser.history()[4], 0.3);
+  for (double w : chooser.history()) {
+    EXPECT_GE(w, kDefensiveFloor);
+    EXPECT_LE(w, 1.0 - kDefensiveFloor);
+  }
+
+  Film fixed(8, 8);
+  o.film = &fixed;
+  o.samples = 2048;
+  o.seed = 7;
+  (void)record_weight_paths(scene, family, Strategy::parse("mix:cosine=0.5,light=0.5"), 0.5, {0.5}, o);
+
+  double chi2 = 0.0;
+  int terms = 0;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    double ma[3], mb[3], va[3], vb[3];
+    automatic.mean(i, ma);
+    fixed.mean(i, mb);
+    automatic.variance_of_mean(i, va);
+    fixed.variance_of_mean(i, vb);
+    for (int c = 0; c < 3; ++c)
+      if (va[c] + vb[c] > 0.0) {
+        chi2 += (ma[c] - mb[c]) * (ma[c] - mb[c]) / (va[c] + vb[c]);
+        ++terms;
+      }
+  }
+  ASSERT_GT(terms, 150);
+  // Mean of z^2 over ~190 terms: 1 +- 0.1 for equal expectations; heavy-tailed
+  // pixels make it noisier, so allow [0.5, 1.6].
+  EXPECT_GT(chi2 / terms, 0.5);
+  EXPECT_LT(chi2 / terms, 1.6) << "the two images differ by more than their noise";
 }
 
 }  // namespace

@@ -184,8 +184,16 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
     svg += "<rect x=\"" + fmt("%.1f", std::min(a, b)) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" +
            fmt("%.1f", std::fabs(b - a)) + "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"#fde9b8\"/>\n";
   }
-  for (int k = 0; k <= 10; ++k) {
-    const double xv = x0 + (x1 - x0) * k / 10.0, x = px(xv);
+  // Ticks at 1, 2 or 5 times a power of ten, at most ten steps over the range.
+  const double raw_step = (x1 - x0) / 10.0, step_magnitude = std::pow(10.0, std::floor(std::log10(raw_step)));
+  double x_step = 10.0 * step_magnitude;
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * step_magnitude >= raw_step * (1.0 - 1e-9)) {
+      x_step = m * step_magnitude;
+      break;
+    }
+  for (double xv = std::ceil(x0 / x_step - 1e-9) * x_step; xv <= x1 + 1e-9 * x_step; xv += x_step) {
+    const double x = px(xv);
     svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
            fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
     svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +

@@ -40,6 +40,7 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
             m.rest = has_rest ? rest_weight * plan_rest.pdf(v.point, v.normal, v.direction) : 0.0f;
             vertices.push_back(m);
           }
+          if (o.film) o.film->add(static_cast<std::size_t>(y * width + x), radiance);  // pixels of disjoint rows
           const float rgb[3] = {radiance.x, radiance.y, radiance.z};
           predictor.add_path(y * width + x, rgb, vertices, static_cast<double>(record.segments));
         }
@@ -50,6 +51,19 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   for (std::thread& t : pool) t.join();
   for (std::size_t t = 1; t < parts.size(); ++t) parts[0].merge(parts[t]);
   return std::move(parts[0]);
+}
+
+AutoWeight::AutoWeight(double first, int grid_points)
+    : grid_(weight_grid(grid_points)), sum_(grid_.size(), 0.0), history_{defended_weight(first)} {}
+
+void AutoWeight::add_pass(const WeightPrediction& prediction) {
+  if (prediction.efficiency.size() != grid_.size()) return;
+  ++passes_;
+  for (std::size_t g = 0; g < grid_.size(); ++g) sum_[g] += prediction.efficiency[g];
+  std::size_t best = 0;
+  for (std::size_t g = 1; g < grid_.size(); ++g)
+    if (sum_[g] > sum_[best]) best = g;
+  history_.push_back(sum_[best] > 0.0 ? defended_weight(grid_[best]) : history_.back());
 }
 
 }  // namespace pdflab

@@ -3,6 +3,7 @@
 // render's pixel samples through the one-path tracer, which records each
 // diffuse vertex's point, normal and drawn direction, and evaluates there the
 // densities of the two varied techniques and of the fixed rest.
+#include "renderer/film/film.h"
 #include "renderer/metrics/weight_prediction.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/scene/scene.h"
@@ -24,6 +25,7 @@ struct WeightPathOptions {
   std::uint64_t seed = 2;
   std::uint32_t first_sample = 0, samples = 64;  // per pixel: sample indices first .. first + samples - 1
   int threads = 0;                               // <= 0: hardware threads
+  Film* film = nullptr;  // when given (at the scene's size), the traced samples are added to it
 };
 
 // Traces `samples` per pixel of `scene` (prepared, at its camera size) with
@@ -31,5 +33,27 @@ struct WeightPathOptions {
 // with that seed draws — into a predictor over `grid` with one cell per pixel.
 WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& family, const Strategy& mixture,
                                     double w, const std::vector<double>& grid, const WeightPathOptions& options);
+
+// Auto weight: each pass renders with one fixed weight chosen from the
+// predictions of the passes before it, never from its own samples. Every
+// pass is then an unbiased estimate of the image whatever its weight, and so
+// is their sample-weighted sum. (A weight chosen from a pass's own samples
+// would correlate the weight with those samples' noise, and the sum would no
+// longer be unbiased.)
+class AutoWeight {
+ public:
+  explicit AutoWeight(double first = 0.5, int grid_points = 101);
+  double weight() const { return history_.back(); }  // for the next pass
+  // A finished pass's prediction (on grid()): the next weight is the best of
+  // the mean predicted efficiency so far, kept inside the defensive floor.
+  void add_pass(const WeightPrediction& prediction);
+  const std::vector<double>& grid() const { return grid_; }
+  const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next
+
+ private:
+  std::vector<double> grid_, sum_;
+  int passes_ = 0;
+  std::vector<double> history_;
+};
 
 }  // namespace pdflab
