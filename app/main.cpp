@@ -206,6 +206,7 @@ int main(int argc, char** argv) {
       ->check(non_negative_integer());
   sweep->add_option("--csv", so.csv, "One row per weight (CSV)")->required();
   sweep->add_option("--plot", so.plot, "Efficiency against weight, best weight marked (SVG)");
+  sweep->add_option("--map", so.map, "Each pixel's predicted best weight, blue (0) to red (1) (PNG)");
   sweep->add_option("--threads", so.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   sweep->add_flag("--quiet", so.quiet, "No progress");
   sweep->add_flag("--auto", so.auto_weight,

@@ -272,6 +272,50 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const Family& fam
   return out;
 }
 
+// The per-pixel best weight as a picture: each pixel's weight of least
+// predicted second moment (relative to the reference, as relMSE weighs it), on
+// a blue (0: all B) - white (0.5) - red (1: all A) scale, `scale` x enlarged,
+// with the scale as a bar underneath; grey where no recorded path carried
+// light. Pixels as linear values that the PNG writer's gamma-2 curve maps to
+// the intended colours.
+std::vector<std::uint8_t> best_weight_png(const WeightPredictor& predictor, const std::vector<float>& reference,
+                                          int width, int height) {
+  constexpr int kScale = 6, kBar = 16, kGap = 4;
+  const std::vector<float> best = predictor.best_weight_map(reference, kRelMseEpsilon);
+  const int w = width * kScale, h = height * kScale + kGap + kBar;
+  std::vector<float> rgb(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3, 1.0f);
+  auto colour = [](double t, float out[3]) {  // t in 0..1
+    const float blue[3] = {0.17f, 0.32f, 0.80f}, white[3] = {0.93f, 0.93f, 0.93f}, red[3] = {0.78f, 0.12f, 0.15f};
+    const float* a = t < 0.5 ? blue : white;
+    const float* b = t < 0.5 ? white : red;
+    const float f = static_cast<float>(t < 0.5 ? t * 2.0 : t * 2.0 - 1.0);
+    for (int c = 0; c < 3; ++c) {
+      const float v = a[c] + (b[c] - a[c]) * f;
+      out[c] = v * v;  // the PNG's gamma 2 takes the square root
+    }
+  };
+  auto put = [&](int x, int y, const float c[3]) {
+    float* p = &rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3];
+    p[0] = c[0], p[1] = c[1], p[2] = c[2];
+  };
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int cell = y * width + x;
+      double moment = 0.0;
+      for (int c = 0; c < 3; ++c) moment += predictor.second_moment(cell, 0, c) + predictor.second_moment(cell, predictor.grid().size() - 1, c);
+      float c[3] = {0.25f, 0.25f, 0.25f};
+      if (moment > 0.0 && best[static_cast<std::size_t>(cell)] >= 0.0f) colour(best[static_cast<std::size_t>(cell)], c);
+      for (int dy = 0; dy < kScale; ++dy)
+        for (int dx = 0; dx < kScale; ++dx) put(x * kScale + dx, y * kScale + dy, c);
+    }
+  for (int x = 0; x < w; ++x) {
+    float c[3];
+    colour(static_cast<double>(x) / (w - 1), c);
+    for (int y = height * kScale + kGap; y < h; ++y) put(x, y, c);
+  }
+  return encode_png(rgb, w, h, Transfer::Gamma2);
+}
+
 struct Row {
   double weight = 0.0;
   Strategy strategy;
@@ -301,7 +345,8 @@ int run_sweep(const SweepOptions& o) {
   if (o.threads < 0) throw InputError("--threads must be >= 0");
   check_output_path(o.csv);
   if (!o.plot.empty()) check_output_path(o.plot);
-  check_distinct_outputs({o.csv, o.plot});
+  if (!o.map.empty()) check_output_path(o.map);
+  check_distinct_outputs({o.csv, o.plot, o.map});
   const std::vector<double> weights = parse_weights(o.weights);
   const Family family = parse_family(o.vary, o.strategy);
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
@@ -339,6 +384,7 @@ int run_sweep(const SweepOptions& o) {
   grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
   const MixtureFamily mixture_family = family.mixture_family();
   std::vector<WeightPrediction> predictions;  // one per seed of the pilot
+  std::vector<std::uint8_t> map_png;          // from the pilot's first seed
 
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const bool show_progress = !o.quiet && tty;
@@ -359,6 +405,8 @@ int run_sweep(const SweepOptions& o) {
         po.samples = std::min(run.spp, kPredictionSpp);
         po.threads = o.threads;
         const WeightPredictor predictor = record_weight_paths(*scene, mixture_family, r.strategy, r.weight, grid, po);
+        if (!o.map.empty() && map_png.empty())
+          map_png = best_weight_png(predictor, reference.rgb, scene->camera.width, scene->camera.height);
         predictions.push_back(predictor.predict(reference.rgb, run.seconds / run.spp, kRelMseEpsilon));
       }
       seconds.push_back(run.seconds);
@@ -511,6 +559,7 @@ int run_sweep(const SweepOptions& o) {
     plot = linear_svg(series, po);
   }
   write_file_atomic(o.csv, {reinterpret_cast<const std::uint8_t*>(csv.data()), csv.size()});
+  if (!o.map.empty() && !map_png.empty()) write_file_atomic(o.map, map_png);
   if (!o.plot.empty()) write_file_atomic(o.plot, {reinterpret_cast<const std::uint8_t*>(plot.data()), plot.size()});
 
   std::printf("%-8s %-40s %6s %10s %22s %10s %11s %9s\n", "weight", "strategy", "spp", "relmse", "efficiency (95%)",

@@ -18,6 +18,7 @@ struct SweepOptions {
   std::uint64_t seed = 2;  // not the reference's (see BenchOptions::seed)
   std::string csv;
   std::string plot;       // SVG, optional
+  std::string map;        // PNG of the per-pixel best weight, optional
   int threads = 0;
   bool quiet = false;
   bool auto_weight = false;  // also render with the weight chosen between passes

@@ -236,3 +236,22 @@ TEST_F(SweepCommand, AutoReferenceComesFromTheCache) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(SweepCommand, AutoWeightAddsARow) {
+  make_reference();
+  const ChildResult r =
+      run(sweep_args({"--vary", "cosine,light", "--weights", "0.25:0.75:0.25", "--spp", "16", "--seeds", "2", "--auto"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> header;
+  const auto rows = read_csv(slurp(in_work("out.csv")), header);
+  ASSERT_EQ(rows.size(), 4u);
+  const std::string history = rows[3].at("strategy");
+  ASSERT_EQ(history.rfind("auto:0.5>", 0), 0u) << history;
+  EXPECT_EQ(std::count(history.begin(), history.end(), '>'), 3) << "four passes";
+  EXPECT_GT(number(rows[3], "efficiency"), 0.0);
+  EXPECT_NE(r.out.find("auto weight: efficiency"), std::string::npos) << r.out;
+}
+
+}  // namespace
