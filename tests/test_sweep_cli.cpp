@@ -148,7 +148,8 @@ TEST_F(SweepCommand, BadTechniquesAreBadInput) {
 TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
   make_reference();
   const ChildResult r =
-      run(sweep_args({"--vary", "cosine,light", "--weights", "0:1:0.25", "--spp", "4", "--seeds", "2"}));
+      run(sweep_args({"--vary", "cosine,light", "--weights", "0:1:0.25", "--spp", "4", "--seeds", "2", "--map",
+                      in_work("map.png")}));
   ASSERT_EQ(r.status, 0) << r.err;
   std::vector<std::string> header;
   const auto rows = read_csv(slurp(in_work("out.csv")), header);
@@ -208,6 +209,18 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
             std::string::npos);
   EXPECT_NE(svg.find("weight of cosine"), std::string::npos);
   EXPECT_NE(svg.find("predicted from w = 0.5"), std::string::npos);
+  // The map: a PNG of the reference's size times 6, plus its scale bar.
+  const std::string png = slurp(in_work("map.png"));
+  ASSERT_GT(png.size(), 24u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  const auto be32 = [&](std::size_t at) {
+    return (static_cast<unsigned>(static_cast<unsigned char>(png[at])) << 24) |
+           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 1])) << 16) |
+           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 2])) << 8) |
+           static_cast<unsigned>(static_cast<unsigned char>(png[at + 3]));
+  };
+  EXPECT_EQ(be32(16), 12u * 6u);
+  EXPECT_EQ(be32(20), 8u * 6u + 4u + 16u);
   EXPECT_NE(r.out.find("predicted best weight"), std::string::npos) << r.out;
 }
 
