@@ -162,7 +162,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       }
       // Drawn with the mixture's density, whatever becomes of it: a direction
       // below the surface ends the path, with a probability that depends on the weights.
-      if (record) record->vertices.push_back({hit.point, normal, ds.direction});
+      if (record) record->vertices.push_back({origin, normal, ds.direction});  // where its pdfs were evaluated
       const float cosine = dot(ds.direction, normal);
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
