@@ -168,6 +168,13 @@ void Scene::prepare() {
   scale = s;
 }
 
+namespace {
+// The hit on quad q at distance t along the ray.
+Hit quad_hit(const Quad& q, const Ray& ray, float t) {
+  return {t, ray.origin + ray.direction * t, q.normal, q.material, leaf::quad_hit_error(ray.origin, q.plane_d, t)};
+}
+}  // namespace
+
 bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
   int best_quad = -1, best_sphere = -1;
   float closest = t_max;
@@ -201,12 +208,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     return true;
   }
   if (best_quad >= 0) {
-    const Quad& q = scene.quads[best_quad];
-    hit.t = closest;
-    hit.point = ray.origin + ray.direction * closest;
-    hit.normal = q.normal;
-    hit.material = q.material;
-    hit.error = leaf::quad_hit_error(ray.origin, q.plane_d, closest);
+    hit = quad_hit(scene.quads[best_quad], ray, closest);
     return true;
   }
   return false;
@@ -215,12 +217,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
 bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit) {
   if (aimed_quad < 0) return intersect(scene, ray, kInf, hit);
   if (intersect(scene, ray, distance * kAimedReach, hit)) return true;
-  const Quad& q = scene.quads[static_cast<std::size_t>(aimed_quad)];
-  hit.t = distance;
-  hit.point = ray.origin + ray.direction * distance;
-  hit.normal = q.normal;
-  hit.material = q.material;
-  hit.error = leaf::quad_hit_error(ray.origin, q.plane_d, distance);
+  hit = quad_hit(scene.quads[static_cast<std::size_t>(aimed_quad)], ray, distance);
   return true;
 }
 
