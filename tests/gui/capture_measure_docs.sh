@@ -32,20 +32,20 @@ mkdir -p "$root/docs"
 # Convergence: cosine, pinned, then the book's mixture, pinned, then nee-mis (key 4) against both.
 start cosine
 sleep "$seconds"
-xdotool key --window "$wid" k
-xdotool key --window "$wid" 3
+send_key k
+send_key 3
 sleep "$seconds"
-xdotool key --window "$wid" k
-xdotool key --window "$wid" v
+send_key k
+send_key v
 sleep 2
 shot view_heatmap.png
-xdotool key --window "$wid" v
+send_key v
 sleep 2
 shot view_difference.png
-xdotool key --window "$wid" v
-xdotool key --window "$wid" v   # back to the image
-xdotool key --window "$wid" g   # the plot on (it starts hidden)
-xdotool key --window "$wid" 4
+send_key v
+send_key v   # back to the image
+send_key g   # the plot on (it starts hidden)
+send_key 4
 sleep "$seconds"
 sleep 1
 shot convergence_plot.png
@@ -66,9 +66,9 @@ viewer=$!
 wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 xdotool mousemove 5 5
 sleep 3
-xdotool key --window "$wid" v
-xdotool key --window "$wid" v
-xdotool key --window "$wid" v
+send_key v
+send_key v
+send_key v
 sleep 2
 shot view_drops.png
 stop

@@ -16,7 +16,7 @@ mkdir -p "$art/shots"
 json_field() { /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print(eval("d" + sys.argv[2]))' "$1" "$2"; }
 # save N: F12, wait for the Nth sidecar; prints the stem of the new files.
 save() {
-  xdotool key --window "$wid" F12
+  send_key F12
   for _ in $(seq 100); do [ "$(ls "$art"/shots/*.json 2>/dev/null | wc -l)" -ge "$1" ] && break; sleep 0.1; done
   sleep 0.3
   local json; json=$(ls -t "$art"/shots/*.json | head -1)
@@ -35,7 +35,7 @@ echo "scene's camera: $(json_field "$first.json" '["camera"]')"
 [ "$(json_field "$first.json" '["camera"]["moved"]')" = False ] || fail "the camera was moved before any drag"
 
 echo "== O, then a drag orbits the camera and restarts the render"
-xdotool key --window "$wid" o
+send_key o
 sleep 0.3
 xdotool mousemove "$cx" "$cy" mousedown 1
 for dx in 10 20 30 40; do xdotool mousemove "$((cx + dx))" "$((cy + dx / 4))"; sleep 0.1; done
@@ -49,7 +49,7 @@ echo "orbited camera: $(json_field "$orbited.json" '["camera"]')"
 if cmp -s "$first.pfm" "$orbited.pfm"; then fail "orbiting did not change the image"; fi
 
 echo "== Home: the scene's camera, the same image bit for bit"
-xdotool key --window "$wid" Home
+send_key Home
 sleep 3
 reset=$(save 3)
 [ "$(json_field "$reset.json" '["camera"]["moved"]')" = False ] || fail "Home did not restore the scene's camera"

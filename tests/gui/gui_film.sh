@@ -38,11 +38,11 @@ wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 [ -n "$wid" ] || fail "no viewer window"
 sleep 3
 alive "$pid" "start-up"
-xdotool key --window "$wid" ctrl+s
+send_key ctrl+s
 for _ in $(seq 50); do ls "$art"/shots/*.film >/dev/null 2>&1 && break; sleep 0.1; done
 saved=$(ls "$art"/shots/*.film | head -1)
 [ -s "$saved" ] || fail "Ctrl+S wrote no film"
-xdotool key --window "$wid" F12
+send_key F12
 sleep 1
 quit_viewer "$wid" "$pid"
 "$pdflab" merge "$saved" --stats-json "$art/saved.json" --out "$art/saved.exr" >/dev/null

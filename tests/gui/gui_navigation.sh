@@ -31,7 +31,7 @@ size=$((area < HEIGHT ? area : HEIGHT))
 left=$(((area - size) / 2)) top=$(((HEIGHT - size) / 2))
 echo "window ${WIDTH}x${HEIGHT}, image ${iw}x${ih} fitted at $left,$top size $size"
 sleep 1
-xdotool key --window "$wid" space   # pause: the image on screen stays what F12 saves
+send_key space   # pause: the image on screen stays what F12 saves
 sleep 1
 
 echo "== the inspector's value is the saved PFM's"
@@ -39,14 +39,14 @@ echo "== the inspector's value is the saved PFM's"
 mx=$((left + (30 * size + size / 2) / iw)) my=$((top + (88 * size + size / 2) / ih))
 xdotool mousemove "$mx" "$my"
 sleep 0.5
-xdotool key --window "$wid" ctrl+c
+send_key ctrl+c
 sleep 0.3
 xclip -o -selection clipboard >"$art/inspector.txt"
 cat "$art/inspector.txt"; echo
 read -r px py <<<"$(sed -n 's/^pixel (\([0-9]*\), \([0-9]*\)).*/\1 \2/p' "$art/inspector.txt")"
 shown=$(sed -n 's/^RGB  //p' "$art/inspector.txt")
 [ -n "$px" ] && [ -n "$shown" ] || fail "the inspector copied nothing readable"
-xdotool key --window "$wid" F12
+send_key F12
 for _ in $(seq 100); do ls "$art"/shots/*.json >/dev/null 2>&1 && break; sleep 0.1; done
 sleep 0.5
 pfm=$(ls "$art"/shots/*.pfm) png=$(ls "$art"/shots/*.png)
@@ -78,13 +78,13 @@ echo "colours in 60x60 around the cursor: fitted $fitted, zoomed $zoomed"
 [ "$zoomed" -le 40 ] || fail "zoomed in, the crop has $zoomed colours: not square pixels"
 [ "$fitted" -gt "$zoomed" ] || fail "the wheel did not zoom in"
 # The same image point under the cursor: the inspector still reads the same pixel.
-xdotool key --window "$wid" ctrl+c
+send_key ctrl+c
 sleep 0.3
 xclip -o -selection clipboard | grep -q "^pixel ($px, $py)" || fail "zooming moved the pixel under the cursor"
 
 echo "== Z: one screen pixel per image pixel, the saved PNG exactly"
 xdotool mousemove 2 2
-xdotool key --window "$wid" z
+send_key z
 sleep 0.5
 x0=$(((area - iw) / 2)) y0=$(((HEIGHT - ih) / 2))
 shot actual "${iw}x${ih}+$x0+$y0"
@@ -93,7 +93,7 @@ echo "1:1 crop vs the saved PNG: RMSE $d"
 awk -v d="$d" 'BEGIN { exit !(d < 0.004) }' || fail "at 1:1 the screen is not the saved image (RMSE $d)"
 
 echo "== F fits again"
-xdotool key --window "$wid" f
+send_key f
 sleep 0.5
 shot fit_again "60x60+$((mx - 30))+$((my - 30))"
 d=$(rmse "$art/fitted.png" "$art/fit_again.png")
@@ -101,7 +101,7 @@ echo "fitted vs fitted again: RMSE $d"
 awk -v d="$d" 'BEGIN { exit !(d < 0.01) }' || fail "F did not restore the fitted view"
 echo "== F11: presentation mode, the whole screen and no panel; Esc leaves it"
 shot windowed
-xdotool key --window "$wid" F11
+send_key F11
 sleep 1.5
 eval "$(xdotool getwindowgeometry --shell "$wid")"
 echo "presentation: ${WIDTH}x${HEIGHT}"
@@ -112,7 +112,7 @@ convert "$art/presentation.png" -crop 220x500+1055+150 +repage "$art/presentatio
 sd=$(identify -format "%[fx:standard_deviation]" "$art/presentation_right.png")
 echo "right edge in presentation: stddev $sd"
 awk -v s="$sd" 'BEGIN { exit !(s < 0.02) }' || fail "the side panel still shows in presentation mode"
-xdotool key --window "$wid" Escape
+send_key Escape
 sleep 1.5
 alive "$viewer" "Esc in presentation mode"
 eval "$(xdotool getwindowgeometry --shell "$wid")"

@@ -47,7 +47,7 @@ xdotool mousemove "$((px + 120))" 43 click 1
 sleep 0.5
 shot dropdown "$panel_top"
 changed "$art/panel.png" "$art/dropdown.png" 0.03
-xdotool key --window "$wid" Escape
+send_key Escape
 sleep 0.5
 alive "$viewer" "Esc with a drop-down open"
 xdotool mousemove 2 2
@@ -60,12 +60,12 @@ field="300x22+$((px + 8))+151"
 shot field_before "$field"
 xdotool mousemove "$((px + 200))" 162 click 1
 sleep 0.2
-xdotool key --window "$wid" End
+send_key End
 xdotool type --window "$wid" "xyz"
 sleep 0.3
 shot field_typing "$field"
 changed "$art/field_before.png" "$art/field_typing.png" 0.005
-xdotool key --window "$wid" Escape
+send_key Escape
 sleep 0.5
 alive "$viewer" "Esc in a text field"
 xdotool mousemove 2 2
@@ -78,7 +78,7 @@ echo "== the pixel probe follows a strategy switch"
 # The image is centred left of the panel.
 size=$((px < HEIGHT ? px : HEIGHT))
 left=$(((px - size) / 2)) top=$(((HEIGHT - size) / 2))
-xdotool key --window "$wid" p
+send_key p
 sleep 0.3
 xdotool mousemove "$((left + size * 30 / 100))" "$((top + size * 88 / 100))" click 1
 xdotool mousemove 2 2
@@ -86,12 +86,12 @@ sleep 1
 # The probe window's legend (counts per technique, light samples per target).
 legend="230x150+$((WIDTH - 250))+60"
 shot probe_cosine "$legend"
-xdotool key --window "$wid" 2   # preset: light only
+send_key 2   # preset: light only
 sleep 1
 shot probe_light "$legend"
 changed "$art/probe_cosine.png" "$art/probe_light.png" 0.02
 shot probe_window
-xdotool key --window "$wid" Escape  # leaves probe mode, closes the probe
+send_key Escape  # leaves probe mode, closes the probe
 sleep 0.5
 alive "$viewer" "Esc in probe mode"
 shot probe_left
@@ -99,19 +99,19 @@ changed "$art/probe_window.png" "$art/probe_left.png" 0.02
 
 echo "== Ctrl+Q after a long unsaved render asks first"
 sleep 6
-xdotool key --window "$wid" ctrl+q
+send_key ctrl+q
 sleep 1
 alive "$viewer" "Ctrl+Q after an unsaved render (it must ask first)"
 shot asking
-xdotool key --window "$wid" Escape   # cancel
+send_key Escape   # cancel
 sleep 0.5
 alive "$viewer" "Esc in the quit question"
 shot cancelled
 changed "$art/asking.png" "$art/cancelled.png" 0.02
-xdotool key --window "$wid" ctrl+q
+send_key ctrl+q
 sleep 1
 alive "$viewer" "Ctrl+Q (asking again)"
-xdotool key --window "$wid" ctrl+q   # quit anyway
+send_key ctrl+q   # quit anyway
 for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
 kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q twice did not quit"
 wait "$viewer" || fail "viewer exited with status $?"
@@ -123,7 +123,7 @@ viewer=$!
 trap 'kill $viewer 2>/dev/null || true' EXIT
 wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 sleep 1
-xdotool key --window "$wid" ctrl+q
+send_key ctrl+q
 for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
 kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q after one second asked instead of quitting"
 wait "$viewer" || fail "viewer exited with status $?"

@@ -46,7 +46,7 @@ shot estimated
 [ "$(cached)" -eq 0 ] || fail "the cache is not empty before Make reference"
 
 echo "== Make reference (M): a progress bar, then a cached reference and measured figures"
-xdotool key --window "$wid" m
+send_key m
 sleep 1.5
 shot making
 changed "$art/panel_estimated.png" "$art/panel_making.png" 0.005
@@ -91,7 +91,7 @@ PDFLAB_SCREENSHOT_DIR="$art/shots" PDFLAB_REFERENCE_CACHE="$art/empty_cache" \
   start_viewer --strategy cosine --reference "$art/old.pfm"
 sleep 3
 shot seed_trap
-xdotool key --window "$wid" F12   # the sidecar records the seed the render now uses
+send_key F12   # the sidecar records the seed the render now uses
 for _ in $(seq 40); do ls "$art"/shots/*.json >/dev/null 2>&1 && break; sleep 0.25; done
 quit_viewer "$wid" "$viewer"
 trap - EXIT

@@ -46,12 +46,12 @@ trap 'kill $viewer 2>/dev/null || true' EXIT
 wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
 [ -n "$wid" ] || fail "no viewer window"
 sleep 1
-xdotool key --window "$wid" 3
+send_key 3
 sleep 2
-xdotool key --window "$wid" F12
+send_key F12
 for _ in $(seq 100); do ls "$art"/shots/*.json >/dev/null 2>&1 && [ -s "$(ls "$art"/shots/*.json | head -1)" ] && break; sleep 0.2; done
 sleep 0.5
-xdotool key --window "$wid" F12
+send_key F12
 for _ in $(seq 100); do [ "$(ls "$art"/shots/*.png 2>/dev/null | wc -l)" -ge 2 ] && break; sleep 0.2; done
 sleep 1
 import -window root "$art/window.png"

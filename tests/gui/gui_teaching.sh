@@ -51,7 +51,7 @@ size=$((area_w < HEIGHT ? area_w : HEIGHT))
 left=$(((area_w - size) / 2)) top=$(((HEIGHT - size) / 2))
 
 echo "== split screen"
-xdotool key --window "$wid" s
+send_key s
 sleep "$settle"
 shot split
 not_blank "$art/split.png"
@@ -65,11 +65,11 @@ sleep 1
 shot split_dragged
 changed "$art/split.png" "$art/split_dragged.png"
 [ -n "$docs" ] && cp "$art/split_dragged.png" "$docs/view_split.png"
-xdotool key --window "$wid" s
+send_key s
 sleep 1
 
 echo "== pixel probe"
-xdotool key --window "$wid" p
+send_key p
 sleep 0.5
 # A pixel of the floor, left of the image's centre, low down.
 xdotool mousemove "$((left + size * 30 / 100))" "$((top + size * 88 / 100))" click 1
@@ -78,7 +78,7 @@ sleep 1
 shot probe
 not_blank "$art/probe.png"
 changed "$art/split_dragged.png" "$art/probe.png"
-xdotool key --window "$wid" c
+send_key c
 sleep 0.3
 # The check runs in the background (a fraction of a second here) while the
 # window keeps drawing.
@@ -86,11 +86,11 @@ sleep 3
 shot probe_chi
 changed "$art/probe.png" "$art/probe_chi.png"
 [ -n "$docs" ] && cp "$art/probe_chi.png" "$docs/view_probe.png"
-xdotool key --window "$wid" p
+send_key p
 sleep 0.5
 
 echo "== 1D lab"
-xdotool key --window "$wid" l
+send_key l
 sleep "$settle"
 shot lab
 not_blank "$art/lab.png"
@@ -105,7 +105,7 @@ echo "== 1D lab: f(x) typed as an expression"
 select_all() {
   xdotool keydown --window "$wid" ctrl
   sleep 0.15
-  xdotool key --window "$wid" a
+  send_key a
   sleep 0.15
   xdotool keyup --window "$wid" ctrl
   sleep 0.15
@@ -118,7 +118,7 @@ xdotool mousemove 250 48 click 1
 sleep 0.2
 select_all
 xdotool type --window "$wid" "sin(pi*"
-xdotool key --window "$wid" Return
+send_key Return
 xdotool mousemove 2 2
 sleep 1
 alive "$viewer" "a bad expression"
@@ -129,7 +129,7 @@ xdotool mousemove 250 48 click 1
 sleep 0.2
 select_all
 xdotool type --window "$wid" "sin(pi*x)^2"
-xdotool key --window "$wid" Return
+send_key Return
 xdotool mousemove 2 2
 sleep "$settle"
 shot lab_typed

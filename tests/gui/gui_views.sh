@@ -45,12 +45,12 @@ echo "window ${ww}x${wh}, image crop $crop"
 
 modes=(image heatmap difference drops)
 for i in "${!modes[@]}"; do
-  [ "$i" -eq 0 ] || xdotool key --window "$wid" v
+  [ "$i" -eq 0 ] || send_key v
   sleep 1.5
   import -window "$wid" "$art/window_${modes[$i]}.png"
   convert "$art/window_${modes[$i]}.png" -crop "$crop" +repage "$art/${modes[$i]}.png"
 done
-xdotool key --window "$wid" v   # back to the image
+send_key v   # back to the image
 quit_viewer "$wid" "$viewer"
 trap - EXIT
 

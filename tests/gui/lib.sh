@@ -44,3 +44,13 @@ focus_window() {
   xdotool windowfocus --sync "$wid"
   eval "$(xdotool getwindowgeometry --shell "$wid")"
 }
+
+# Sends keys to the viewer window. XSendEvent (xdotool key --window) is
+# refused with BadWindow by some windows once they have gone full screen or
+# opened a popup under Xvfb; then the keys go through XTEST to the focused window.
+send_key() {
+  xdotool key --window "$wid" "$@" 2>/dev/null && return 0
+  xdotool windowfocus --sync "$wid" 2>/dev/null || true
+  xdotool key "$@"
+}
+
