@@ -7,16 +7,21 @@
 # scripts/convergence_notes.md (prose lives there so a re-run refreshes the
 # numbers without losing it).
 #
-# Its time is about 7 scenes x (REF_SECONDS + 11 strategies x SEEDS x BENCH_SECONDS), plus set-up:
-#   bash scripts/convergence_report.sh     # defaults: about 40 minutes on 2 cores
-#   SIZE=100 BENCH_SECONDS=1 REF_SECONDS=40 bash scripts/convergence_report.sh   # about 11 minutes
+# Each reference gets REF_FACTOR (48) times the samples per pixel of the
+# most-sampled run of its scene: a short calibration run of every strategy
+# measures their speeds first, so the reference's own noise stays a few per cent
+# of the best row's error whatever the machine's speed. Its time is about
+# 7 scenes x (REF_FACTOR x BENCH_SECONDS x (fastest strategy / reference strategy)
+# + 11 strategies x (SEEDS + 1/2) x BENCH_SECONDS), plus set-up:
+#   bash scripts/convergence_report.sh     # defaults: about an hour on 2 cores
+#   SIZE=100 BENCH_SECONDS=1 bash scripts/convergence_report.sh   # about 20 minutes
 #   SCENES="cornell_book small_light" bash scripts/convergence_report.sh
 #
 # Settings (environment): PDFLAB (binary, default build/release/app/pdflab),
 # SIZE (image side, 200), BENCH_SECONDS (render time per strategy and seed, 4),
-# SEEDS (independent runs per strategy, 4: seeds 2, 3, ...), REF_SECONDS (the
-# reference's rendering time; default 40 x BENCH_SECONDS, so that it has about
-# 40 times the samples of its own strategy's run), THREADS (0: all cores).
+# SEEDS (independent runs per strategy, 4: seeds 2, 3, ...), REF_FACTOR (the
+# reference's samples per pixel over the fastest strategy's in calibration, 48;
+# at least 32), THREADS (0: all cores).
 # NOTES_ONLY=1 rebuilds docs/convergence.md from the last run's files (after
 # editing the notes) without rendering.
 set -euo pipefail
@@ -26,7 +31,7 @@ PDFLAB=${PDFLAB:-build/release/app/pdflab}
 SIZE=${SIZE:-200}
 BENCH_SECONDS=${BENCH_SECONDS:-4}
 SEEDS=${SEEDS:-4}
-REF_SECONDS=${REF_SECONDS:-$(awk -v b="$BENCH_SECONDS" 'BEGIN { print 40 * b }')}
+REF_FACTOR=${REF_FACTOR:-48}
 THREADS=${THREADS:-0}
 # What `pdflab reference` renders with by default on these scenes (the most
 # efficient unbiased strategy in the boxes); nee-mis where the report finds it
@@ -43,6 +48,8 @@ else
     [[ $name == cornell_book || $name == small_light ]] || SCENES+=("$name")
   done
 fi
+[[ $REF_FACTOR =~ ^[0-9]+$ ]] && (( REF_FACTOR >= 32 )) ||
+  { echo "convergence_report: REF_FACTOR must be a whole number of at least 32" >&2; exit 2; }
 (( SEEDS >= 2 )) || { echo "convergence_report: SEEDS must be at least 2 (intervals need them)" >&2; exit 2; }
 
 die() { echo "convergence_report: $*" >&2; exit 2; }
@@ -78,8 +85,25 @@ else
 start=$(date +%s)
 for scene in "${SCENES[@]}"; do
   file=assets/scenes/$scene.json
-  echo "== $scene: reference, $REF_SECONDS s at ${SIZE}x$SIZE" >&2
-  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --seconds "$REF_SECONDS" \
+  # Calibration: half the run time for every strategy, no reference;
+  # the fastest one's samples per pixel per second sets the reference's size.
+  echo "== $scene: calibrating the strategies' speeds" >&2
+  # (bench needs a reference to compare with: a rough one does for timing)
+  half=$(awk -v b="$BENCH_SECONDS" 'BEGIN { print b / 2 }')
+  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --seconds "$half" \
+    --threads "$THREADS" --cache-dir "$work/calibration" --out "$work/$scene.calibration.pfm" --quiet >&2
+  "$PDFLAB" bench --scene "$file" --strategies "$strategy_list" --seconds "$half" \
+    --reference "$work/$scene.calibration.pfm" --threads "$THREADS" --quiet --csv "$work/$scene.calibration.csv" >&2
+  ref_spp=$(awk -v f="$REF_FACTOR" -v b="$BENCH_SECONDS" '
+    NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
+    {
+      sub(/"[^"]*"/, "s")  # the strategy, which may hold commas
+      split($0, g, ",")
+      if (g[col["seconds"]] > 0 && g[col["spp"]] / g[col["seconds"]] > rate) rate = g[col["spp"]] / g[col["seconds"]]
+    }
+    END { n = int(f * rate * b) + 1; print (n > 1 ? n : 1) }' "$work/$scene.calibration.csv")
+  echo "== $scene: reference, $ref_spp spp at ${SIZE}x$SIZE ($REF_FACTOR x the fastest run's)" >&2
+  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --spp "$ref_spp" \
     --strategy "${REF_STRATEGY_OF[$scene]:-$REF_STRATEGY}" \
     --threads "$THREADS" --cache-dir "$cache" --out "$work/$scene.pfm" --quiet >&2
   cp "$work/$scene.json" "docs/convergence_${scene}_reference.json"
@@ -108,7 +132,7 @@ commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 run_date=$(date -u +%Y-%m-%d)
 {
   echo "elapsed=$elapsed commit=$commit run_date=$run_date SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS SEEDS=$SEEDS"
-  echo "REF_SECONDS=$REF_SECONDS"
+  echo "REF_FACTOR=$REF_FACTOR"
   echo "SCENES=(${SCENES[*]})"
   echo "strategies_run=$(printf '%q' "$strategy_list")"
 } > "$run_info"
@@ -214,7 +238,7 @@ summary() {
     }
     END {
       share = best_r > 0 ? noise / best_r : 0
-      printf "Reference: `pdflab reference`, `%s`, %d spp in %.0f s (%.0fx the spp of its own strategy'"'"'s run, %.0fx the most of any run); ", ref_strategy, ref_spp, ref_seconds, (own_spp > 0 ? ref_spp / own_spp : 0), (max_spp > 0 ? ref_spp / max_spp : 0)
+      printf "Reference: `pdflab reference`, `%s`, %d spp in %.0f s (%.0fx the spp of its own strategy'"'"'s run, %.0fx the most of any run%s); ", ref_strategy, ref_spp, ref_seconds, (own_spp > 0 ? ref_spp / own_spp : 0), (max_spp > 0 ? ref_spp / max_spp : 0), (max_spp > 0 && ref_spp < 32 * max_spp ? ", LESS than the 32x this report aims at" : "")
       printf "its own noise (relMSE %.3g) is **%.1f%%** of the best row'"'"'s relMSE (`%s`, %.4g)%s. ", noise, 100 * share, best_rs, best_r, (share <= 0.05 ? ", within the 5% this report aims at" : ", MORE than the 5% this report aims at: the ranking of the best rows is not settled")
       printf "Most efficient unbiased strategy here: `%s`, %.3gx the efficiency of `cosine` (95%% interval %.3g to %.3g over %d seeds). ", best_es, best_ratio, best_lo, best_hi, seeds
       printf "The film'"'"'s own estimate of relMSE (no reference) is %.2gx the measured value for `cosine` and %.2gx for `%s`.\n", (cm > 0 ? cest / cm : 0), (best_m > 0 ? best_est / best_m : 0), best_es
@@ -226,9 +250,10 @@ summary() {
 # Convergence: what each sampling strategy buys per second
 
 Generated by \`scripts/convergence_report.sh\` (commit \`$commit\`, $run_date, $(nproc) cores,
-$elapsed s in all) with \`SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS SEEDS=$SEEDS REF_SECONDS=$REF_SECONDS\`.
+$elapsed s in all) with \`SIZE=$SIZE BENCH_SECONDS=$BENCH_SECONDS SEEDS=$SEEDS REF_FACTOR=$REF_FACTOR\`.
 Each scene is rendered at ${SIZE}x$SIZE. Its reference is made by \`pdflab reference\` (seeds reserved for
-references) for $REF_SECONDS s with its default strategy, \`$REF_STRATEGY\`, or where that is far from the
+references) with $REF_FACTOR times the samples per pixel of the fastest strategy's run (measured by a short
+calibration run first), with its default strategy, \`$REF_STRATEGY\`, or where that is far from the
 most efficient, the one named below the table (\`nee-mis\` for the far light); every strategy then
 renders for $BENCH_SECONDS s (equal time) with each of $SEEDS seeds (2 to $((SEEDS + 1))), and is compared with it.
 
