@@ -203,6 +203,21 @@ struct Viewer::Impl {
   void after_reference_changed();
   void service_references();
   void handle_measure_requests(const ui::MeasureRequests& r);
+
+  // The steps of a frame, in order (see Viewer::frame).
+  struct FrameLayout;
+  void handle_input();
+  void service_background();
+  bool wants_draw(Clock::time_point t0, bool force_draw);
+  void upload_textures();
+  FrameLayout lay_out(int fb_w, int fb_h);
+  void draw_panel(const FrameLayout& l, ui::UiRequests& requests);
+  void draw_overlays(const FrameLayout& l, ui::UiRequests& requests);
+  void draw_quit_question();
+  void apply_requests(const ui::UiRequests& requests);
+  void draw_gl(const FrameLayout& l);
+  void record_frame(Clock::time_point t0, double cpu0);
+  void pace(Clock::time_point t0);
 };
 
 void Viewer::Impl::open(const ViewerOptions& o) {
@@ -933,6 +948,177 @@ Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
 
 Viewer::~Viewer() { impl_->close(); }
 
+// The frame's place on screen: the panel on the right (none while presenting),
+// the image area left of it, and the image within the area (zoom and pan).
+struct Viewer::Impl::FrameLayout {
+  int fb_w = 0, fb_h = 0;      // the framebuffer
+  float panel_width = 0.0f;    // ImGui coordinates
+  int panel_px = 0;            // framebuffer pixels
+  ui::Viewport area;           // the image area, framebuffer pixels (origin bottom left)
+  ui::Viewport image_fb;       // the image, framebuffer pixels
+  ui::ImageRect image_rect;    // the image, ImGui coordinates, for what is drawn over it
+  ui::ImageRect area_rect;     // the image area, ImGui coordinates
+};
+
+void Viewer::Impl::handle_input() {
+  // Last frame's quick releases first (see open_window), then the new events.
+  pressed_this_frame.clear();
+  for (const Release& r : std::exchange(deferred_releases, {}))
+    if (imgui_key_callback) imgui_key_callback(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+  glfwPollEvents();
+  for (const KeyPress& k : keys) on_key(k.key, k.mods);
+  keys.clear();
+}
+
+void Viewer::Impl::service_background() {
+  pull_image();
+  service_references();
+  teaching->update(*session, settings.paused);
+  service_screenshots();
+}
+
+bool Viewer::Impl::wants_draw(Clock::time_point t0, bool force_draw) {
+  if (input_events != seen_input_events) {
+    seen_input_events = input_events;
+    settle_frames = 3;
+  }
+  // Elapsed time and samples/s tick between images: a few redraws a second show that.
+  return force_draw || texture_stale || teaching->wants_frames() || settle_frames > 0 || fonts_dirty ||
+         ImGui::IsAnyItemActive() || t0 - last_draw > std::chrono::milliseconds(250);
+}
+
+void Viewer::Impl::upload_textures() {
+  if (settings.ui_scale != ui_scale) fonts_dirty = true;
+  if (fonts_dirty) rebuild_fonts();
+  if (texture_stale) {
+    display->upload(image.data(), image_info.data_width, image_info.data_height);
+    texture_stale = false;
+  }
+  if (measure.refresh_layer(settings.measure.view_mode))
+    view_texture->upload(measure.layer.rgba.data(), measure.layer.width, measure.layer.height);
+}
+
+Viewer::Impl::FrameLayout Viewer::Impl::lay_out(int fb_w, int fb_h) {
+  const ImGuiIO& io = ImGui::GetIO();
+  FrameLayout l;
+  l.fb_w = fb_w;
+  l.fb_h = fb_h;
+  l.panel_width = settings.presentation ? 0.0f : std::min(kPanelWidth * scale() / framebuffer_scale, io.DisplaySize.x);
+  const float fbs = framebuffer_scale;
+  l.panel_px = static_cast<int>(l.panel_width * fbs);
+  l.area = {0, 0, std::max(0, fb_w - l.panel_px), fb_h};
+  navigate(l.area, fb_h);  // zoom and pan move the image within its area
+  l.image_fb = view.place(l.area, image_info.width, image_info.height);
+  l.image_rect = {static_cast<float>(l.image_fb.x) / fbs,
+                  static_cast<float>(fb_h - l.image_fb.y - l.image_fb.height) / fbs,
+                  static_cast<float>(l.image_fb.width) / fbs, static_cast<float>(l.image_fb.height) / fbs};
+  l.area_rect = {0.0f, 0.0f, io.DisplaySize.x - l.panel_width, io.DisplaySize.y};
+  return l;
+}
+
+void Viewer::Impl::draw_panel(const FrameLayout& l, ui::UiRequests& requests) {
+  const ImGuiIO& io = ImGui::GetIO();
+  if (!settings.presentation) {
+    ui::draw_side_panel(l.panel_width, io.DisplaySize.y, settings, panel, status, requests);
+    ui::draw_image_badges(settings, status);
+  } else if (now() - presentation_since < 3.0) {
+    ui::draw_hint("Presentation mode: F11 or Esc leaves");
+  }
+  if (camera_mode) ui::draw_hint("Camera: drag orbits, right-drag pans, wheel dollies; Home resets, O or Esc leaves");
+  ui::draw_help_overlay(panel, io.DisplaySize.x - l.panel_width, io.DisplaySize.y);
+  if (!status.notice.text.empty() && now() - status.notice.shown_at < 6.0)
+    ui::draw_notice_toast(status.notice, l.area_rect.width, l.area_rect.height);
+}
+
+void Viewer::Impl::draw_overlays(const FrameLayout& l, ui::UiRequests& requests) {
+  // Layers, the divider, the probe's cross: never over the panel, however far the image reaches.
+  const ui::ImageRect& a = l.area_rect;
+  ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(a.x, a.y), ImVec2(a.x + a.width, a.y + a.height));
+  ui::draw_image_overlays(l.image_rect, a, settings, measure, view_texture->id(), requests);
+  teaching->draw_ui(*session, l.image_fb, l.fb_h, framebuffer_scale, a.width, a.height);
+  if (!settings.presentation) inspect(l.image_rect, a);
+  else inspected.reset();
+  ImGui::GetBackgroundDrawList()->PopClipRect();
+}
+
+void Viewer::Impl::draw_quit_question() {
+  if (!quit_asking) return;
+  switch (ui::draw_quit_dialog(unsaved_seconds(), quit_after_save || save_job.valid(), status.notice)) {
+    case ui::QuitChoice::SaveAndQuit:
+      quit_after_save = true;
+      screenshot_wanted = true;
+      break;
+    case ui::QuitChoice::Quit: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
+    case ui::QuitChoice::Cancel: quit_asking = quit_after_save = false; break;
+    case ui::QuitChoice::None: break;
+  }
+}
+
+// What the panel's and the overlays' widgets asked for this frame, after the
+// UI is built: a restart, a new scene, pause, the stop, saves, modes.
+void Viewer::Impl::apply_requests(const ui::UiRequests& requests) {
+  if (!requests.load_scene.empty()) load_scene(requests.load_scene);
+  else if (requests.restart_render) apply_render_settings();
+  if (requests.pause_changed) session->set_paused(settings.paused);
+  if (requests.stop_changed) {
+    session->set_target_spp(settings.stop_spp);
+    applied.stop_spp = settings.stop_spp;
+  }
+  if (requests.screenshot) screenshot_wanted = true;
+  if (requests.toggle_presentation) set_presentation(!settings.presentation);
+  if (requests.toggle_camera_mode) {
+    camera_mode = !camera_mode;
+    if (camera_mode) teaching->leave_probe_mode();
+  }
+  if (requests.reset_camera) reset_camera();
+  handle_measure_requests(requests.measure);
+  if (requests.retry_screenshot && failed_save) {
+    ui::ScreenshotData data = std::move(*failed_save);
+    failed_save.reset();
+    start_save(std::move(data));
+  }
+}
+
+void Viewer::Impl::draw_gl(const FrameLayout& l) {
+  glViewport(0, 0, l.fb_w, l.fb_h);
+  glClearColor(0.05f, 0.05f, 0.055f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  if (teaching->split_active())
+    teaching->draw_split_image(l.image_fb, settings.exposure_ev, settings.srgb);
+  else
+    display->draw(l.image_fb, settings.exposure_ev, settings.srgb);
+  glViewport(0, 0, l.fb_w, l.fb_h);
+  // The panel's background after the image: a zoomed image reaching past its area is cut there.
+  if (l.panel_px > 0) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(l.fb_w - l.panel_px, 0, l.panel_px, l.fb_h);
+    glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+  }
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  glfwSwapBuffers(window);
+}
+
+void Viewer::Impl::record_frame(Clock::time_point t0, double cpu0) {
+  report.work_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  report.cpu_ms = thread_cpu_ms() - cpu0;
+  report.drawn = true;
+  report.shown_generation = image_info.generation;
+  report.shown_preview = image_info.preview;
+  report.shown_spp = image_info.spp;
+}
+
+void Viewer::Impl::pace(Clock::time_point t0) {
+  // Events wake the wait early, so input is never delayed by the pacing.
+  const SessionStats& st = status.stats;
+  const bool busy = !(st.done || st.paused) || save_job.valid() || screenshot_wanted || references->running() ||
+                    ImGui::IsAnyItemActive() || status.now - status.notice.shown_at < 0.5 || teaching->wants_frames();
+  const double period = busy ? kFramePeriod : kIdlePeriod;
+  const double spent = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (spent < period) glfwWaitEventsTimeout(period - spent);
+}
+
 bool Viewer::frame(bool paced, bool force_draw) {
   Impl& v = *impl_;
   if (glfwWindowShouldClose(v.window)) return false;
@@ -940,17 +1126,8 @@ bool Viewer::frame(bool paced, bool force_draw) {
   const double cpu0 = thread_cpu_ms();
   v.report.new_image = false;
   v.report.drawn = false;
-  // Last frame's quick releases first (see open_window), then the new events.
-  v.pressed_this_frame.clear();
-  for (const Impl::Release& r : std::exchange(v.deferred_releases, {}))
-    if (v.imgui_key_callback) v.imgui_key_callback(v.window, r.key, r.scancode, GLFW_RELEASE, r.mods);
-  glfwPollEvents();
-  for (const Impl::KeyPress& k : v.keys) v.on_key(k.key, k.mods);
-  v.keys.clear();
-  v.pull_image();
-  v.service_references();
-  v.teaching->update(*v.session, v.settings.paused);
-  v.service_screenshots();
+  v.handle_input();
+  v.service_background();
 
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(v.window, &fb_w, &fb_h);
@@ -960,140 +1137,31 @@ bool Viewer::frame(bool paced, bool force_draw) {
     glfwWaitEventsTimeout(0.1);
     return !glfwWindowShouldClose(v.window);
   }
-
-  if (v.input_events != v.seen_input_events) {
-    v.seen_input_events = v.input_events;
-    v.settle_frames = 3;
-  }
-  // Elapsed time and samples/s tick between images: a few redraws a second show that.
-  const bool draw = force_draw || v.texture_stale || v.teaching->wants_frames() || v.settle_frames > 0 || v.fonts_dirty || ImGui::IsAnyItemActive() ||
-                    t0 - v.last_draw > std::chrono::milliseconds(250);
-  if (!draw) {
+  if (!v.wants_draw(t0, force_draw)) {
     if (paced) glfwWaitEventsTimeout(kFramePeriod);
     return !glfwWindowShouldClose(v.window);
   }
   if (v.settle_frames > 0) --v.settle_frames;
   v.last_draw = t0;
 
-  if (v.settings.ui_scale != v.ui_scale) v.fonts_dirty = true;
-  if (v.fonts_dirty) v.rebuild_fonts();
-  if (v.texture_stale) {
-    v.display->upload(v.image.data(), v.image_info.data_width, v.image_info.data_height);
-    v.texture_stale = false;
-  }
-  if (v.measure.refresh_layer(v.settings.measure.view_mode))
-    v.view_texture->upload(v.measure.layer.rgba.data(), v.measure.layer.width, v.measure.layer.height);
-
+  v.upload_textures();
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   if (v.close_popups) ImGui::ClosePopupToLevel(0, true);
   v.close_popups = false;
   v.fill_status();
-  const ImGuiIO& io = ImGui::GetIO();
-  const bool presenting = v.settings.presentation;
-  const float panel_width =
-      presenting ? 0.0f : std::min(kPanelWidth * v.scale() / v.framebuffer_scale, io.DisplaySize.x);
-  const float fbs = v.framebuffer_scale;
-  const int panel_px = static_cast<int>(panel_width * fbs);
-  const ui::Viewport area{0, 0, std::max(0, fb_w - panel_px), fb_h};
-  v.navigate(area, fb_h);
-  // The image's place, in framebuffer pixels and in ImGui coordinates for what is drawn over it.
-  const ui::Viewport image_fb = v.view.place(area, v.image_info.width, v.image_info.height);
-  const ui::ImageRect image_rect{static_cast<float>(image_fb.x) / fbs,
-                                 static_cast<float>(fb_h - image_fb.y - image_fb.height) / fbs,
-                                 static_cast<float>(image_fb.width) / fbs, static_cast<float>(image_fb.height) / fbs};
-  const ui::ImageRect area_rect{0.0f, 0.0f, io.DisplaySize.x - panel_width, io.DisplaySize.y};
-  // Layers, the divider, the probe's cross: never over the panel, however far the image reaches.
-  ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(area_rect.x, area_rect.y),
-                                               ImVec2(area_rect.x + area_rect.width, area_rect.y + area_rect.height));
+  const Impl::FrameLayout layout = v.lay_out(fb_w, fb_h);
   ui::UiRequests requests;
-  if (!presenting) {
-    ui::draw_side_panel(panel_width, io.DisplaySize.y, v.settings, v.panel, v.status, requests);
-    ui::draw_image_badges(v.settings, v.status);
-  } else if (v.now() - v.presentation_since < 3.0) {
-    ui::draw_hint("Presentation mode: F11 or Esc leaves");
-  }
-  if (v.camera_mode) ui::draw_hint("Camera: drag orbits, right-drag pans, wheel dollies; Home resets, O or Esc leaves");
-  ui::draw_help_overlay(v.panel, io.DisplaySize.x - panel_width, io.DisplaySize.y);
-  if (!v.status.notice.text.empty() && v.now() - v.status.notice.shown_at < 6.0)
-    ui::draw_notice_toast(v.status.notice, area_rect.width, area_rect.height);
-  ui::draw_image_overlays(image_rect, area_rect, v.settings, v.measure, v.view_texture->id(), requests);
-  v.teaching->draw_ui(*v.session, image_fb, fb_h, v.framebuffer_scale, area_rect.width, area_rect.height);
-  if (!presenting) v.inspect(image_rect, area_rect);
-  else v.inspected.reset();
-  ImGui::GetBackgroundDrawList()->PopClipRect();
-  if (v.quit_asking) {
-    switch (ui::draw_quit_dialog(v.unsaved_seconds(), v.quit_after_save || v.save_job.valid(), v.status.notice)) {
-      case ui::QuitChoice::SaveAndQuit:
-        v.quit_after_save = true;
-        v.screenshot_wanted = true;
-        break;
-      case ui::QuitChoice::Quit: glfwSetWindowShouldClose(v.window, GLFW_TRUE); break;
-      case ui::QuitChoice::Cancel: v.quit_asking = v.quit_after_save = false; break;
-      case ui::QuitChoice::None: break;
-    }
-  }
+  v.draw_panel(layout, requests);
+  v.draw_overlays(layout, requests);
+  v.draw_quit_question();
   ImGui::Render();
 
-  if (!requests.load_scene.empty()) v.load_scene(requests.load_scene);
-  else if (requests.restart_render) v.apply_render_settings();
-  if (requests.pause_changed) v.session->set_paused(v.settings.paused);
-  if (requests.stop_changed) {
-    v.session->set_target_spp(v.settings.stop_spp);
-    v.applied.stop_spp = v.settings.stop_spp;
-  }
-  if (requests.screenshot) v.screenshot_wanted = true;
-  if (requests.toggle_presentation) v.set_presentation(!v.settings.presentation);
-  if (requests.toggle_camera_mode) {
-    v.camera_mode = !v.camera_mode;
-    if (v.camera_mode) v.teaching->leave_probe_mode();
-  }
-  if (requests.reset_camera) v.reset_camera();
-  v.handle_measure_requests(requests.measure);
-  if (requests.retry_screenshot && v.failed_save) {
-    ui::ScreenshotData data = std::move(*v.failed_save);
-    v.failed_save.reset();
-    v.start_save(std::move(data));
-  }
-
-  glViewport(0, 0, fb_w, fb_h);
-  glClearColor(0.05f, 0.05f, 0.055f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  if (v.teaching->split_active())
-    v.teaching->draw_split_image(image_fb, v.settings.exposure_ev, v.settings.srgb);
-  else
-    v.display->draw(image_fb, v.settings.exposure_ev, v.settings.srgb);
-  glViewport(0, 0, fb_w, fb_h);
-  // The panel's background after the image: a zoomed image reaching past its area is cut there.
-  if (panel_px > 0) {
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(fb_w - panel_px, 0, panel_px, fb_h);
-    glClearColor(ui::kPanelBackground[0], ui::kPanelBackground[1], ui::kPanelBackground[2], 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glDisable(GL_SCISSOR_TEST);
-  }
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-  glfwSwapBuffers(v.window);
-
-  const auto t1 = Clock::now();
-  v.report.work_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  v.report.cpu_ms = thread_cpu_ms() - cpu0;
-  v.report.drawn = true;
-  v.report.shown_generation = v.image_info.generation;
-  v.report.shown_preview = v.image_info.preview;
-  v.report.shown_spp = v.image_info.spp;
-
-  if (paced) {
-    // Events wake the wait early, so input is never delayed by the pacing.
-    const SessionStats& st = v.status.stats;
-    const bool busy = !(st.done || st.paused) || v.save_job.valid() || v.screenshot_wanted || v.references->running() ||
-                      ImGui::IsAnyItemActive() || v.status.now - v.status.notice.shown_at < 0.5 ||
-                      v.teaching->wants_frames();
-    const double period = busy ? kFramePeriod : kIdlePeriod;
-    const double spent = std::chrono::duration<double>(Clock::now() - t0).count();
-    if (spent < period) glfwWaitEventsTimeout(period - spent);
-  }
+  v.apply_requests(requests);
+  v.draw_gl(layout);
+  v.record_frame(t0, cpu0);
+  if (paced) v.pace(t0);
   return !glfwWindowShouldClose(v.window);
 }
 
