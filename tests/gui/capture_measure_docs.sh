@@ -5,27 +5,21 @@
 #   tests/gui/capture_measure_docs.sh [PDFLAB] [SECONDS_PER_STRATEGY]
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
+inside_xvfb "1400x900x24" "xdotool import" "$0" "$@"
+shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 pdflab=${1:-$root/build/release/app/pdflab}
 seconds=${2:-20}
-if [ "${INSIDE_XVFB:-}" != 1 ]; then
-  INSIDE_XVFB=1 exec xvfb-run -a -s "-screen 0 1400x900x24" bash "$0" "$pdflab" "$seconds"
-fi
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+at_exit='rm -rf "$work"'
 scene=$work/cornell_400.json
 sed -e 's/"width": 600, "height": 600/"width": 400, "height": 400/' "$root/assets/scenes/cornell_book.json" >"$scene"
 grep -q '"width": 400' "$scene" || { echo "could not resize the scene"; exit 1; }
 echo "reference: nee-mis, 256 spp"
 "$pdflab" render --scene "$scene" --strategy nee-mis --spp 256 --seed 7 --out "$work/ref.pfm" --quiet
 
-start() {  # start STRATEGY: the viewer in the background, its window id in $wid
-  "$pdflab" --scene "$scene" --strategy "$1" --reference "$work/ref.pfm" &
-  viewer=$!
-  wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-  xdotool mousemove 5 5
-}
-stop() { quit_viewer "$wid" "$viewer"; }
+start() { start_viewer "$pdflab" --scene "$scene" --strategy "$1" --reference "$work/ref.pfm"; }
+stop() { quit_viewer; }
 shot() { import -window "$wid" "$root/docs/$1"; echo "wrote docs/$1"; }
 
 mkdir -p "$root/docs"
@@ -52,20 +46,14 @@ shot convergence_plot.png
 stop
 
 # The nee-mis note is in the panel; the plot and views stay out of the way.
-"$pdflab" --scene "$scene" --strategy nee-mis:balance &
-viewer=$!
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-xdotool mousemove 5 5
-sleep 5
+start_viewer "$pdflab" --scene "$scene" --strategy nee-mis:balance
+sleep 4
 shot nee_mis_note.png
 stop
 
 # The drop overlay: the tiny-target test scene, whose light pdf overflows.
-"$pdflab" --scene "$root/tests/gui/tiny_target.json" --strategy "mix:cosine=0.5,light=0.5" &
-viewer=$!
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-xdotool mousemove 5 5
-sleep 3
+start_viewer "$pdflab" --scene "$root/tests/gui/tiny_target.json" --strategy "mix:cosine=0.5,light=0.5"
+sleep 2
 send_key v
 send_key v
 send_key v

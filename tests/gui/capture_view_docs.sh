@@ -5,24 +5,17 @@
 #   tests/gui/capture_view_docs.sh [PDFLAB] [SECONDS]
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
+inside_xvfb "1400x900x24" "xdotool import" "$0" "$@"
+shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 pdflab=${1:-$root/build/release/app/pdflab}
 seconds=${2:-20}
-if [ "${INSIDE_XVFB:-}" != 1 ]; then
-  INSIDE_XVFB=1 exec xvfb-run -a -s "-screen 0 1400x900x24" bash "$0" "$pdflab" "$seconds"
-fi
 scene=$root/assets/scenes/cornell_book.json
 
-"$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" &
-viewer=$!
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-sleep 1
-xdotool windowfocus --sync "$wid"
-eval "$(xdotool getwindowgeometry --shell "$wid")"
+start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
 area=$((WIDTH - 400))
 size=$((area < HEIGHT ? area : HEIGHT))
 left=$(((area - size) / 2)) top=$(((HEIGHT - size) / 2))
-xdotool mousemove 5 5
 sleep "$seconds"
 # The glass sphere: zoom in about it, the inspector reads the pixel under the cursor.
 mx=$((left + size * 58 / 100)) my=$((top + size * 77 / 100))
@@ -31,13 +24,10 @@ for _ in $(seq 4); do xdotool click 4; sleep 0.05; done
 sleep 1
 import -window "$wid" "$root/docs/view_zoom.png"
 echo "wrote docs/view_zoom.png"
-quit_viewer "$wid" "$viewer"
+quit_viewer
 
-"$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" --presentation &
-viewer=$!
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-xdotool mousemove 5 5
+start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" --presentation
 sleep "$seconds"
 import -window root "$root/docs/view_presentation.png"
 echo "wrote docs/view_presentation.png"
-quit_viewer "$wid" "$viewer"
+quit_viewer

@@ -13,7 +13,6 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art/shots"
-json_field() { /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print(eval("d" + sys.argv[2]))' "$1" "$2"; }
 # save N: F12, wait for the Nth sidecar; prints the stem of the new files.
 save() {
   send_key F12
@@ -24,15 +23,12 @@ save() {
 }
 
 # 16 spp and stop: every image below is complete and comparable.
-PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine --spp 16 &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-focus_window
+PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine --spp 16
 cx=$(((WIDTH - 400) / 2)) cy=$((HEIGHT / 2))
 sleep 2
 first=$(save 1)
-echo "scene's camera: $(json_field "$first.json" '["camera"]')"
-[ "$(json_field "$first.json" '["camera"]["moved"]')" = False ] || fail "the camera was moved before any drag"
+echo "scene's camera: $(json_field "$first.json" camera)"
+[ "$(json_field "$first.json" camera moved)" = False ] || fail "the camera was moved before any drag"
 
 echo "== O, then a drag orbits the camera and restarts the render"
 send_key o
@@ -43,18 +39,17 @@ xdotool mouseup 1
 xdotool mousemove 2 2
 sleep 3
 orbited=$(save 2)
-echo "orbited camera: $(json_field "$orbited.json" '["camera"]')"
-[ "$(json_field "$orbited.json" '["camera"]["moved"]')" = True ] || fail "the sidecar does not show the moved camera"
-[ "$(json_field "$orbited.json" '["spp"]')" = 16 ] || fail "the orbited render did not finish its 16 spp"
+echo "orbited camera: $(json_field "$orbited.json" camera)"
+[ "$(json_field "$orbited.json" camera moved)" = True ] || fail "the sidecar does not show the moved camera"
+[ "$(json_field "$orbited.json" spp)" = 16 ] || fail "the orbited render did not finish its 16 spp"
 if cmp -s "$first.pfm" "$orbited.pfm"; then fail "orbiting did not change the image"; fi
 
 echo "== Home: the scene's camera, the same image bit for bit"
 send_key Home
 sleep 3
 reset=$(save 3)
-[ "$(json_field "$reset.json" '["camera"]["moved"]')" = False ] || fail "Home did not restore the scene's camera"
+[ "$(json_field "$reset.json" camera moved)" = False ] || fail "Home did not restore the scene's camera"
 cmp "$first.pfm" "$reset.pfm" || fail "after Home the image differs from the first"
 echo "first and reset PFMs are identical"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 echo "PASS"

@@ -12,7 +12,6 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art/shots"
-json_field() { /usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
 
 echo "== the viewer continues a film from the command line"
 "$pdflab" render --scene "$scene" --strategy cosine --spp 8 --seed 3 --film-out "$art/part.film" --quiet
@@ -32,19 +31,16 @@ grep -q "strategy" "$art/bad_resume.txt" || fail "the message does not name the 
 [ ! -e "$art/never.png" ] || fail "bad input left a screenshot"
 
 echo "== Ctrl+S saves the accumulation as a film"
-PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine --spp 16 &
-pid=$!
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-sleep 3
-alive "$pid" "start-up"
+PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine --spp 16
+sleep 2
+alive "$viewer" "start-up"
 send_key ctrl+s
 for _ in $(seq 50); do ls "$art"/shots/*.film >/dev/null 2>&1 && break; sleep 0.1; done
 saved=$(ls "$art"/shots/*.film | head -1)
 [ -s "$saved" ] || fail "Ctrl+S wrote no film"
 send_key F12
 sleep 1
-quit_viewer "$wid" "$pid"
+quit_viewer
 "$pdflab" merge "$saved" --stats-json "$art/saved.json" --out "$art/saved.exr" >/dev/null
 [ "$(json_field "$art/saved.json" spp)" = 16 ] || fail "the saved film holds $(json_field "$art/saved.json" spp) spp, not 16"
 "$pdflab" render --resume "$saved" --spp 32 --film-out "$art/more.film" --out "$art/more.pfm" --quiet

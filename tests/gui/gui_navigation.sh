@@ -13,17 +13,9 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art/shots"
-rmse() { (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p'; }
 colours() { identify -format "%k" "$1"; }
-shot() {
-  import -window "$wid" "$art/$1.png"
-  [ -z "${2:-}" ] || convert "$art/$1.png" -crop "$2" +repage "$art/$1.png"
-}
 
-PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-focus_window
+PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine
 "$pdflab" render --scene "$scene" --strategy cosine --spp 1 --out "$art/size.png" --quiet >/dev/null
 read -r iw ih <<<"$(identify -format '%w %h' "$art/size.png")"
 area=$((WIDTH - 400))
@@ -117,6 +109,5 @@ sleep 1.5
 alive "$viewer" "Esc in presentation mode"
 eval "$(xdotool getwindowgeometry --shell "$wid")"
 [ "$WIDTH" = 720 ] || fail "Esc did not leave presentation mode (${WIDTH}x${HEIGHT})"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 echo "PASS"

@@ -14,27 +14,8 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
-rmse() { (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p'; }
-# changed A B [FLOOR] / same A B [CEILING]: RMSE (0..1) of two captures.
-changed() {
-  local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") -> $(basename "$2"): RMSE $d"
-  awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d > f) }' || fail "$2 did not change from $1"
-}
-same() {
-  local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") vs $(basename "$2"): RMSE $d"
-  awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d <= f) }' || fail "$2 differs from $1"
-}
-# shot NAME [GEOMETRY]: the window, or a crop of it.
-shot() {
-  import -window "$wid" "$art/$1.png"
-  [ -z "${2:-}" ] || convert "$art/$1.png" -crop "$2" +repage "$art/$1.png"
-}
 
-"$pdflab" --scene "$scene" --strategy cosine &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-focus_window
-xdotool mousemove 2 2
+start_viewer "$pdflab" --scene "$scene" --strategy cosine
 sleep 0.5
 px=$((WIDTH - 400))  # the side panel's left edge
 # The panel's top rows: the strategy drop-down, then (below what it covers
@@ -114,18 +95,14 @@ alive "$viewer" "Ctrl+Q (asking again)"
 send_key ctrl+q   # quit anyway
 for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
 kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q twice did not quit"
-wait "$viewer" || fail "viewer exited with status $?"
-trap - EXIT
+pid=$viewer viewer=
+wait "$pid" || fail "viewer exited with status $?"
 
 echo "== a short render quits at once"
-"$pdflab" --scene "$scene" --strategy cosine &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-sleep 1
+start_viewer "$pdflab" --scene "$scene" --strategy cosine
 send_key ctrl+q
 for _ in $(seq 50); do kill -0 "$viewer" 2>/dev/null || break; sleep 0.1; done
 kill -0 "$viewer" 2>/dev/null && fail "Ctrl+Q after one second asked instead of quitting"
-wait "$viewer" || fail "viewer exited with status $?"
-trap - EXIT
+pid=$viewer viewer=
+wait "$pid" || fail "viewer exited with status $?"
 echo "PASS"

@@ -15,32 +15,17 @@ pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
 export PDFLAB_REFERENCE_CACHE="$art/cache"
-rmse() { (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p'; }
-changed() {
-  local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") -> $(basename "$2"): RMSE $d"
-  awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d > f) }' || fail "$2 did not change from $1"
-}
 shot() {
   import -window "$wid" "$art/window_$1.png"
   convert "$art/window_$1.png" -crop "400x${HEIGHT}+$((WIDTH - 400))+0" +repage "$art/panel_$1.png"
 }
 cached() { find "$PDFLAB_REFERENCE_CACHE" -name '*.json' 2>/dev/null | wc -l; }
 
-start_viewer() {
-  # The last viewer's window must be gone, or the search below could find it.
-  for _ in $(seq 50); do xdotool search --name '^pdflab' >/dev/null 2>&1 || break; sleep 0.1; done
-  "$pdflab" --scene "$scene" "$@" 2>"$art/viewer_stderr.txt" &
-  viewer=$!
-  trap 'kill $viewer 2>/dev/null || true' EXIT
-  wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-  [ -n "$wid" ] || fail "no viewer window"
-  xdotool windowfocus --sync "$wid" || true
-  xdotool mousemove 2 2
-  eval "$(xdotool getwindowgeometry --shell "$wid")"  # WIDTH HEIGHT
-}
+# open_viewer ARG...: the viewer on the scene, its messages in viewer_stderr.txt.
+open_viewer() { start_viewer "$pdflab" --scene "$scene" "$@" 2>"$art/viewer_stderr.txt"; }
 
 echo "== no reference: estimates"
-start_viewer --strategy cosine --reference-seconds 4
+open_viewer --strategy cosine --reference-seconds 4
 sleep 3
 shot estimated
 [ "$(cached)" -eq 0 ] || fail "the cache is not empty before Make reference"
@@ -58,8 +43,7 @@ changed "$art/panel_making.png" "$art/panel_measured.png" 0.005
 alive "$viewer" "Make reference"
 grep -q "note: made a reference, stored as $PDFLAB_REFERENCE_CACHE/" "$art/viewer_stderr.txt" ||
   fail "the viewer did not report the reference it made"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 ls -l "$PDFLAB_REFERENCE_CACHE"
 [ "$(find "$PDFLAB_REFERENCE_CACHE" -name '*.pfm' | wc -l)" -eq 2 ] || fail "expected a mean and a variance PFM"
 
@@ -70,40 +54,36 @@ cat "$art/render_auto.txt"
 grep -q "relMSE .* against $PDFLAB_REFERENCE_CACHE" "$art/render_auto.txt" || fail "render --reference auto missed it"
 
 echo "== a second viewer loads it by itself"
-start_viewer --strategy cosine
+open_viewer --strategy cosine
 sleep 3
 shot autoloaded
 grep -q "note: loaded the cached reference $PDFLAB_REFERENCE_CACHE/" "$art/viewer_stderr.txt" ||
   fail "the second viewer did not load the cached reference"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 
 echo "== a biased strategy without a reference: no efficiency"
-PDFLAB_REFERENCE_CACHE="$art/empty_cache" start_viewer --strategy light
+PDFLAB_REFERENCE_CACHE="$art/empty_cache" open_viewer --strategy light
 sleep 3
 shot biased
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 echo "== the seed trap: a screenshot (seed 1, cosine) loaded as the reference of a cosine render at seed 1"
 "$pdflab" --scene "$scene" --strategy cosine --spp 16 --screenshot "$art/old.png" >/dev/null
 grep -q '"seed": 1' "$art/old.json" || fail "the screenshot's sidecar does not record seed 1"
 PDFLAB_SCREENSHOT_DIR="$art/shots" PDFLAB_REFERENCE_CACHE="$art/empty_cache" \
-  start_viewer --strategy cosine --reference "$art/old.pfm"
+  open_viewer --strategy cosine --reference "$art/old.pfm"
 sleep 3
 shot seed_trap
 send_key F12   # the sidecar records the seed the render now uses
 for _ in $(seq 40); do ls "$art"/shots/*.json >/dev/null 2>&1 && break; sleep 0.25; done
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 grep -h '"seed"' "$art"/shots/*.json
 grep -q '"seed": 2' "$art"/shots/*.json || fail "the viewer kept the reference's seed"
 echo "== a damaged cached reference: named and ignored, the viewer keeps running"
 for f in "$PDFLAB_REFERENCE_CACHE"/*.pfm; do head -c 100 "$f" >"$f.cut" && mv "$f.cut" "$f"; done
-start_viewer --strategy cosine
+open_viewer --strategy cosine
 sleep 3
 shot damaged
 alive "$viewer" "a damaged cached reference"
 grep -q "damaged and was ignored" "$art/viewer_stderr.txt" || fail "a damaged cached reference was not named"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 echo "PASS"

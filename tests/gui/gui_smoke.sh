@@ -16,7 +16,6 @@ mkdir -p "$art/shots"
 png_stats() { identify -format "%w %h %[fx:mean] %[fx:standard_deviation]" "$1"; }
 # abs_diff A B
 abs_diff() { awk -v a="$1" -v b="$2" 'BEGIN { d = a - b; if (d < 0) d = -d; printf "%.6f", d }'; }
-json_field() { /usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
 
 echo "== bad input exits 2 without a window"
 set +e
@@ -40,12 +39,7 @@ read -r w h _ _ <<<"$(png_stats "$art/cli.png")"
 [ "$(json_field "$art/cli.json" spp)" = 8 ] || fail "cli.json spp"
 
 echo "== interactive: preset key 3, then F12 twice"
-PDFLAB_SCREENSHOT_DIR="$art/shots" "$pdflab" --scene "$scene" --strategy cosine &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-sleep 1
+PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine
 send_key 3
 sleep 2
 send_key F12
@@ -55,8 +49,7 @@ send_key F12
 for _ in $(seq 100); do [ "$(ls "$art"/shots/*.png 2>/dev/null | wc -l)" -ge 2 ] && break; sleep 0.2; done
 sleep 1
 import -window root "$art/window.png"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 
 ls -l "$art/shots"
 [ "$(ls "$art"/shots/*.png | wc -l)" -eq 2 ] || fail "expected two screenshots (names must not collide)"

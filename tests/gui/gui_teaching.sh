@@ -24,21 +24,8 @@ not_blank() {
   echo "$(basename "$1"): mean=$mean sd=$sd"
   awk -v m="$mean" -v s="$sd" 'BEGIN { exit !(m > 0.02 && s > 0.02) }' || fail "$1 looks blank"
 }
-# changed A B: root-mean-square difference (0..1) above a small floor.
-changed() {
-  local d
-  # compare exits 1 when the images differ: that is the expected case here.
-  d=$( (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p')
-  echo "$(basename "$1") -> $(basename "$2"): RMSE $d"
-  awk -v d="$d" 'BEGIN { exit !(d > 0.01) }' || fail "$2 did not change from $1"
-}
-shot() { import -window "$wid" "$art/$1.png"; }
 
-"$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-focus_window
-xdotool mousemove 2 2
+start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
 sleep 2
 shot base
 not_blank "$art/base.png"
@@ -138,6 +125,5 @@ changed "$art/lab_bad.png" "$art/lab_typed.png"
 awk -v r="$(red_line "$art/lab_typed.png")" 'BEGIN { exit !(r < 0.001) }' || fail "sin(pi*x)^2 was refused"
 [ -n "$docs" ] && cp "$art/lab_typed.png" "$docs/view_lab1d.png"
 
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 echo "PASS"

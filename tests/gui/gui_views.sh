@@ -13,8 +13,6 @@ pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
 stddev() { identify -format "%[fx:standard_deviation]" "$1"; }
-# Normalised RMSE between two images of the same size, 0..1.
-difference() { { compare -metric RMSE "$1" "$2" null: 2>&1 || true; } | sed -E 's/.*\((.*)\).*/\1/'; }
 
 echo "== a reference at the scene's size, and one at another size"
 "$pdflab" render --scene "$scene" --strategy cosine --spp 64 --out "$art/reference.pfm" --quiet
@@ -28,20 +26,13 @@ set -e
 cat "$art/bad_reference.txt"
 
 # The strategy drops samples on this scene (its pdf overflows for the tiny target).
-"$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" --reference "$art/reference.pfm" &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-[ -n "$wid" ] || fail "no viewer window"
-xdotool mousemove 5 5
+start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" --reference "$art/reference.pfm"
 sleep 3
-sleep 1
 # The image sits centred in the area left of the 400-pixel panel.
-read -r ww wh <<<"$(xdotool getwindowgeometry "$wid" | awk '/Geometry/ { split($2, g, "x"); print g[1], g[2] }')"
-area=$((ww - 400))
-side=$(( area < wh ? area : wh ))
-crop="$((side - 40))x$((side - 40))+$((20 + (area - side) / 2))+$((20 + (wh - side) / 2))"
-echo "window ${ww}x${wh}, image crop $crop"
+area=$((WIDTH - 400))
+side=$(( area < HEIGHT ? area : HEIGHT ))
+crop="$((side - 40))x$((side - 40))+$((20 + (area - side) / 2))+$((20 + (HEIGHT - side) / 2))"
+echo "window ${WIDTH}x${HEIGHT}, image crop $crop"
 
 modes=(image heatmap difference drops)
 for i in "${!modes[@]}"; do
@@ -51,8 +42,7 @@ for i in "${!modes[@]}"; do
   convert "$art/window_${modes[$i]}.png" -crop "$crop" +repage "$art/${modes[$i]}.png"
 done
 send_key v   # back to the image
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+quit_viewer
 
 for m in "${modes[@]}"; do
   sd=$(stddev "$art/$m.png")
@@ -62,20 +52,15 @@ done
 for a in "${modes[@]}"; do
   for b in "${modes[@]}"; do
     [[ "$a" < "$b" ]] || continue
-    d=$(difference "$art/$a.png" "$art/$b.png")
+    d=$(rmse "$art/$a.png" "$art/$b.png")
     echo "$a vs $b: $d"
     awk -v d="$d" 'BEGIN { exit !(d > 0.02) }' || fail "$a and $b views look the same"
   done
 done
 
 echo "== a reference of another size: the viewer says so and offers the reference's size"
-"$pdflab" --scene "$scene" --strategy cosine --reference "$art/small.pfm" &
-viewer=$!
-trap 'kill $viewer 2>/dev/null || true' EXIT
-wid=$(timeout 30 xdotool search --sync --name '^pdflab' | head -1)
-xdotool mousemove 5 5
-sleep 3
-import -window "$wid" "$art/window_mismatch.png"
-quit_viewer "$wid" "$viewer"
-trap - EXIT
+start_viewer "$pdflab" --scene "$scene" --strategy cosine --reference "$art/small.pfm"
+sleep 2
+shot window_mismatch
+quit_viewer
 echo "PASS"
