@@ -35,8 +35,6 @@ bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, boo
   return true;
 }
 
-}  // namespace
-
 // Next-event estimation with MIS: at each diffuse vertex one light sample
 // (shadow ray, solid-angle sampling of the emitters chosen by power) and one
 // cosine sample. Emission reached by the cosine sample is weighted against the
@@ -119,6 +117,8 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
   }
   return radiance;
 }
+
+}  // namespace
 
 Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops,
                 PathRecord* record) {
