@@ -33,6 +33,13 @@ inline float positive_part(float x) { return x > 0.0f ? x : 0.0f; }
 inline float max_abs_component(const Vec3& a) {
   return max_of(std::fabs(a.x), max_of(std::fabs(a.y), std::fabs(a.z)));
 }
+// Rec. 709 luminance, in double: the brightness a viewer sees. The noise and
+// error measures, the viewer's readouts and an emitter's power all use it.
+inline constexpr double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+template <class T>
+constexpr double luminance(const T* rgb) {
+  return luminance(rgb[0], rgb[1], rgb[2]);
+}
 inline bool is_finite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }

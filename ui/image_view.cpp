@@ -1,16 +1,12 @@
 #include "ui/image_view.h"
 
+#include "renderer/math.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 namespace pdflab::ui {
-
-namespace {
-
-double luminance(const float c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
-}  // namespace
 
 Viewport ImageView::place(const Viewport& area, int image_width, int image_height) const {
   if (fit) return fit_image(area, image_width, image_height);

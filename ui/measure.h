@@ -1,11 +1,16 @@
 #pragma once
-// Measuring the speed-accuracy trade in the viewer, as plain data: view modes,
-// the reference image, error figures of each published pass, convergence
-// curves, colour maps and their legends. No ImGui and no OpenGL here, so every
-// number the panels show can be unit-tested.
+// Measuring the speed-accuracy trade in the viewer, as plain data: the
+// settings and requests of the measuring panels, the error figures of each
+// published pass, and the state that ties them together. The colour scales
+// (colour_scale.h), the convergence recorder (convergence.h) and the error
+// layers (error_layers.h) each have their own file. No ImGui and no OpenGL
+// here, so every number the panels show can be unit-tested.
 #include "renderer/metrics/metrics.h"
 #include "renderer/metrics/reference.h"
 #include "renderer/session/session.h"
+#include "ui/colour_scale.h"
+#include "ui/convergence.h"
+#include "ui/error_layers.h"
 
 #include <array>
 #include <cstdint>
@@ -13,11 +18,6 @@
 #include <vector>
 
 namespace pdflab::ui {
-
-enum class ViewMode : std::uint8_t { Image, RelativeError, Difference, Drops, Count };
-inline constexpr int kViewModeCount = static_cast<int>(ViewMode::Count);
-const char* view_mode_label(ViewMode mode);
-ViewMode next_view_mode(ViewMode mode);
 
 // The measuring part of ViewerSettings.
 struct MeasureSettings {
@@ -44,14 +44,9 @@ struct MeasureRequests {
   bool clear_pins = false;
 };
 
-// The reference (renderer/metrics/reference.h): mean, variance, sidecar.
-using ReferenceImage = pdflab::Reference;
-
 // Reads a reference (a PFM, with its variance and sidecar when they are
 // there). Throws InputError naming the file when it cannot.
 using pdflab::load_reference;
-// Empty when the sizes agree; otherwise a sentence saying which is which.
-std::string reference_size_mismatch(const ReferenceImage& reference, int render_width, int render_height);
 
 // The figures of one published full pass.
 struct Figures {
@@ -84,101 +79,6 @@ struct Figures {
 Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, const ReferenceImage* reference,
                         bool unbiased = true);
 
-struct CurvePoint {
-  double spp = 0.0, seconds = 0.0, error = 0.0;
-};
-
-struct Curve {
-  std::string label;       // the strategy, as `pdflab render --strategy` takes it
-  bool estimated = false;  // errors from the film's variance, not from a reference
-  std::vector<CurvePoint> points;
-};
-
-// Points of the running strategy as passes complete, and pinned curves to
-// compare against. Points come from the published image's own spp and seconds,
-// so the error and its abscissa always belong to the same pass.
-class ConvergenceRecorder {
- public:
-  static constexpr std::size_t kMaxPins = 6;
-  // Points closer than this factor in spp are skipped: passes come ever more
-  // often as spp grows, and a log axis needs only a few per decade.
-  static constexpr double kMinSppStep = 1.02;
-
-  // Adds a point; a new generation, label or error source starts a new live
-  // curve. Non-positive or non-finite errors (a black image, 1 spp) are skipped.
-  // Returns whether the point was kept.
-  bool record(std::uint64_t generation, const std::string& label, bool estimated, std::uint32_t spp, double seconds,
-              double error);
-  // Keeps the live curve (two points at least) under its label; the oldest pin
-  // goes when there are kMaxPins. Returns false when there was nothing to keep.
-  bool pin();
-  void clear_pins() { pins_.clear(); }
-  const Curve& live() const { return live_; }
-  const std::vector<Curve>& pins() const { return pins_; }
-
- private:
-  Curve live_;
-  std::uint64_t generation_ = 0;
-  bool started_ = false;
-  std::vector<Curve> pins_;
-};
-
-// A logarithmic axis snapped to whole decades.
-struct LogRange {
-  double lo = 1.0, hi = 10.0;
-  double position(double v) const;  // 0 at lo, 1 at hi
-};
-// Covers every positive finite value; one decade at least; [1, 10] when there is none.
-LogRange log_range(const std::vector<double>& values);
-std::vector<double> decade_ticks(const LogRange& range);
-
-using Colour = std::array<float, 3>;  // display RGB in 0..1
-// Dark purple to pale yellow, monotonic in lightness so a grey print still orders it.
-Colour sequential_colour(double t);  // t in 0..1
-// Blue below zero, near-white at zero, red above.
-Colour diverging_colour(double t);  // t in -1..1
-// One colour per DropReason, and one for a pixel with several reasons.
-Colour drop_reason_colour(int reason);
-inline constexpr Colour kSeveralDropReasonsColour = {1.0f, 1.0f, 1.0f};
-
-// The value scale of a false-colour view and its legend.
-struct ColourScale {
-  bool logarithmic = false;
-  bool diverging = false;  // symmetric: -hi..hi
-  double lo = 0.0, hi = 1.0;
-  std::string title;
-  double position(double v) const;  // 0..1 along the colour bar
-  Colour colour(double v) const;
-};
-struct LegendTick {
-  double position = 0.0;  // 0..1 along the bar
-  std::string label;
-};
-std::vector<LegendTick> legend_ticks(const ColourScale& scale);
-
-// The heat map's scale: relative standard error, logarithmic, 0.001 to 10.
-ColourScale relative_error_scale();
-// The difference view's: symmetric about 0, up to `half_range`.
-ColourScale difference_scale(double half_range);
-// 1, 2 or 5 times a power of ten, at least v.
-double nice_ceiling(double v);
-// Luminance of (image - reference) per pixel.
-std::vector<float> luminance_difference(const std::vector<float>& rgb, const std::vector<float>& reference);
-// A half range for the difference view: the 99th percentile of |d|, made nice,
-// so a few fireflies do not wash the rest out.
-double difference_half_range(const std::vector<float>& difference);
-
-// A false-colour layer as RGBA8, row 0 at the top, drawn over (Drops) or
-// instead of (the others) the image. Returns false with the reason in `why`
-// when the mode cannot be shown for this image (a preview, no reference, ...).
-struct ViewLayer {
-  std::vector<std::uint8_t> rgba;
-  int width = 0, height = 0;
-  ColourScale scale;  // for the colour bar (unused for Drops)
-  std::array<std::uint64_t, 4> drop_pixels{};  // Drops: pixels per reason (+ several, last)
-};
-bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why);
 
 // A "Make reference" in progress, as the panel shows it.
 struct ReferenceBuildStatus {

@@ -26,13 +26,6 @@ constexpr ImU32 kLiveColour = IM_COL32(255, 255, 255, 255);
 
 ImU32 to_u32(const Colour& c, float alpha = 1.0f) { return ImGui::ColorConvertFloat4ToU32(ImVec4(c[0], c[1], c[2], alpha)); }
 
-std::string tick_text(double v) {
-  char buf[32];
-  if (v >= 1e-3 && v < 1e5) std::snprintf(buf, sizeof buf, "%g", v);
-  else std::snprintf(buf, sizeof buf, "1e%d", static_cast<int>(std::lround(std::log10(v))));
-  return buf;
-}
-
 void figure_row(const char* label, const char* tooltip, const char* fmt, double value) {
   ImGui::TableNextColumn();
   ImGui::TextColored(kDim, "%s", label);
@@ -199,8 +192,8 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
   const auto py = [&](double y) { return b.y - (b.y - a.y) * static_cast<float>(yr.position(y)); };
 
   dl->PushClipRect(ImVec2(a.x - 1.0f, a.y - 1.0f), ImVec2(b.x + 1.0f, b.y + 1.0f), true);
-  for (double t : decade_ticks(xr)) dl->AddLine(ImVec2(px(t), a.y), ImVec2(px(t), b.y), IM_COL32(70, 70, 80, 255));
-  for (double t : decade_ticks(yr)) dl->AddLine(ImVec2(a.x, py(t)), ImVec2(b.x, py(t)), IM_COL32(70, 70, 80, 255));
+  for (double t : decade_ticks(xr.lo, xr.hi)) dl->AddLine(ImVec2(px(t), a.y), ImVec2(px(t), b.y), IM_COL32(70, 70, 80, 255));
+  for (double t : decade_ticks(yr.lo, yr.hi)) dl->AddLine(ImVec2(a.x, py(t)), ImVec2(b.x, py(t)), IM_COL32(70, 70, 80, 255));
   if (anchor_curve && !anchor_curve->points.empty() && !xs.empty()) {
     const CurvePoint& p0 = anchor_curve->points.front();
     const double x0 = x_of(p0);
@@ -227,13 +220,13 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
   dl->AddRect(a, b, IM_COL32(140, 140, 150, 255));
 
   const ImU32 text = IM_COL32(215, 215, 220, 255);
-  for (double t : decade_ticks(xr)) {
-    const std::string s = tick_text(t);
+  for (double t : decade_ticks(xr.lo, xr.hi)) {
+    const std::string s = tick_label(t);
     const float w = ImGui::CalcTextSize(s.c_str()).x;
     dl->AddText(ImVec2(std::clamp(px(t) - w * 0.5f, a.x - left * 0.5f, b.x - w), b.y + 2.0f), text, s.c_str());
   }
-  for (double t : decade_ticks(yr)) {
-    const std::string s = tick_text(t);
+  for (double t : decade_ticks(yr.lo, yr.hi)) {
+    const std::string s = tick_label(t);
     const float w = ImGui::CalcTextSize(s.c_str()).x;
     dl->AddText(ImVec2(a.x - w - 4.0f, std::clamp(py(t) - font * 0.5f, a.y - font * 0.5f, b.y - font)), text, s.c_str());
   }

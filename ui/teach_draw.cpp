@@ -20,30 +20,6 @@ double Axis::to_unit(double v) const {
   return hi != lo ? (v - lo) / (hi - lo) : 0.5;  // hi < lo: a reversed axis
 }
 
-std::vector<double> nice_ticks(double lo, double hi, int max_ticks) {
-  std::vector<double> ticks;
-  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || max_ticks < 2) return ticks;
-  const double rough = (hi - lo) / (max_ticks - 1);
-  const double decade = std::pow(10.0, std::floor(std::log10(rough)));
-  double step = decade * 10.0;
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (decade * m >= rough) {
-      step = decade * m;
-      break;
-    }
-  const double first = std::ceil(lo / step - 1e-9) * step;
-  for (double t = first; t <= hi + step * 1e-9; t += step) ticks.push_back(std::abs(t) < step * 1e-9 ? 0.0 : t);
-  return ticks;
-}
-
-std::vector<double> decade_ticks(double lo, double hi) {
-  std::vector<double> ticks;
-  if (!(lo > 0.0) || !(hi > lo)) return ticks;
-  for (int e = static_cast<int>(std::ceil(std::log10(lo) - 1e-9)); e <= static_cast<int>(std::floor(std::log10(hi) + 1e-9)); ++e)
-    ticks.push_back(std::pow(10.0, e));
-  return ticks;
-}
-
 Axis fit_axis(const std::vector<double>& values, bool log, double pad) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (double v : values) {
@@ -59,15 +35,6 @@ Axis fit_axis(const std::vector<double>& values, bool log, double pad) {
   }
   const double span = hi > lo ? hi - lo : std::max(std::abs(hi), 1.0);
   return {lo - span * pad, hi + span * pad, false};
-}
-
-std::string tick_label(double v) {
-  char buf[32];
-  const double a = std::abs(v);
-  if (a == 0.0) return "0";
-  if (a >= 1e4 || a < 1e-2) std::snprintf(buf, sizeof buf, "%.0e", v);
-  else std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
 }
 
 ImU32 colormap(float t) {

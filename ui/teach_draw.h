@@ -2,6 +2,8 @@
 // Small plotting and colour helpers for the teaching views, drawn with ImGui's
 // draw list (ImPlot is not packaged on Debian). The axis and tick maths is
 // plain code so it can be tested without an ImGui context.
+#include "renderer/metrics/ticks.h"
+
 #include <imgui.h>
 
 #include <string>
@@ -17,15 +19,13 @@ struct Axis {
   double to_unit(double v) const;
 };
 
-// Tick values at 1, 2 or 5 times a power of ten, at most about `max_ticks`.
-std::vector<double> nice_ticks(double lo, double hi, int max_ticks = 6);
-// Powers of ten inside [lo, hi] (lo > 0).
-std::vector<double> decade_ticks(double lo, double hi);
+// Ticks and their labels: the one rule of every plot (renderer/metrics/ticks.h).
+using pdflab::decade_ticks;
+using pdflab::nice_ticks;
+using pdflab::tick_label;
 // A range that contains every finite value of `values` (and `extra`), widened
 // a little so curves do not touch the frame; positive-only for log axes.
 Axis fit_axis(const std::vector<double>& values, bool log, double pad = 0.05);
-// Short tick label: 0.5, 2, 1e-3, 1e+04.
-std::string tick_label(double v);
 
 // Colour map for densities: dark blue through magenta and orange to pale
 // yellow, rising in brightness so it still reads in grey. t is clamped to 0..1.

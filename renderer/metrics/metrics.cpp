@@ -12,9 +12,6 @@ void check_sizes(const std::vector<float>& a, const std::vector<float>& b) {
   if (a.size() != b.size() || a.empty()) throw std::invalid_argument("images differ in size or are empty");
 }
 
-// Rec. 709 luminance: the noise a viewer sees.
-double luminance(const double rgb[3]) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
-
 }  // namespace
 
 double rmse(const std::vector<float>& image, const std::vector<float>& reference) {

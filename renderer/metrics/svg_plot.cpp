@@ -1,5 +1,7 @@
 #include "renderer/metrics/svg_plot.h"
 
+#include "renderer/metrics/ticks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -66,15 +68,15 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
     const double x = left + (d - lx0) / (lx1 - lx0) * pw;
     svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
            fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">1e" +
-           fmt("%.0f", d) + "</text>\n";
+    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
+           tick_label(std::pow(10.0, d)) + "</text>\n";
   }
   for (double d = ly0; d <= ly1 + 1e-9; d += 1.0) {
     const double y = top + (ly1 - d) / (ly1 - ly0) * ph;
     svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
            "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">1e" +
-           fmt("%.0f", d) + "</text>\n";
+    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" +
+           tick_label(std::pow(10.0, d)) + "</text>\n";
   }
   svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
          "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
@@ -158,13 +160,7 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
     }
   if (!(y1 > 0.0)) y1 = 1.0;
   // A round top: 1, 2 or 5 times a power of ten, five grid lines.
-  const double magnitude = std::pow(10.0, std::floor(std::log10(y1)));
-  double top_value = magnitude;
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * magnitude >= y1 * (1.0 + 1e-9)) {
-      top_value = m * magnitude;
-      break;
-    }
+  const double top_value = nice_ceiling(y1 * (1.0 + 1e-9));
   const double x0 = o.x_min, x1 = o.x_max > o.x_min ? o.x_max : o.x_min + 1.0;
 
   std::size_t longest = o.marker_label.size();
@@ -185,26 +181,20 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
            fmt("%.1f", std::fabs(b - a)) + "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"#fde9b8\"/>\n";
   }
   // Ticks at 1, 2 or 5 times a power of ten, at most ten steps over the range.
-  const double raw_step = (x1 - x0) / 10.0, step_magnitude = std::pow(10.0, std::floor(std::log10(raw_step)));
-  double x_step = 10.0 * step_magnitude;
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * step_magnitude >= raw_step * (1.0 - 1e-9)) {
-      x_step = m * step_magnitude;
-      break;
-    }
+  const double x_step = nice_ceiling((x1 - x0) / 10.0 * (1.0 - 1e-9));
   for (double xv = std::ceil(x0 / x_step - 1e-9) * x_step; xv <= x1 + 1e-9 * x_step; xv += x_step) {
     const double x = px(xv);
     svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
            fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
     svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
-           fmt("%.3g", xv) + "</text>\n";
+           tick_label(xv) + "</text>\n";
   }
   for (int k = 0; k <= 5; ++k) {
     const double yv = top_value * k / 5.0, y = py(yv);
     svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
            "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
     svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" +
-           fmt("%.3g", yv) + "</text>\n";
+           tick_label(yv) + "</text>\n";
   }
   svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
          "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";

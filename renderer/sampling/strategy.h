@@ -5,6 +5,7 @@
 #include "renderer/math.h"
 #include "renderer/sampling/discrete.h"
 #include "renderer/sampling/rng.h"
+#include "renderer/sampling/target_set.h"
 #include "renderer/sampling/technique_table.h"
 #include "renderer/sampling/techniques.h"
 #include "renderer/scene/scene.h"
@@ -51,43 +52,6 @@ struct Strategy {
   bool operator==(const Strategy&) const = default;
 };
 
-// Importance targets with the probability of choosing each, split by kind so
-// that evaluating their pdf needs no per-target switch.
-struct TargetSet {
-  struct QuadEntry {
-    const Quad* quad;
-    float probability;
-    std::int32_t index;  // in Scene::quads (DirectionSample::aimed_quad)
-  };
-  struct SphereEntry {
-    const Sphere* sphere;
-    float probability;
-  };
-  std::vector<QuadEntry> quads;
-  std::vector<SphereEntry> spheres;
-  // Which target a 32-bit number chooses (over quads, then spheres); each
-  // entry's `probability` is exactly its realised share.
-  DiscreteDistribution choice;
-  bool solid_angle = false;  // quads by spherical rectangle instead of by area
-
-  bool empty() const { return quads.empty() && spheres.empty(); }
-  int size() const { return static_cast<int>(quads.size() + spheres.size()); }
-  // Probabilities proportional to `weights` (same order: quads, then spheres),
-  // realised in multiples of 2^-32; a target with a positive weight below that
-  // keeps a share of 2^-32, so that it is still reached (a light 1e-12 as
-  // bright as another is still sampled, with the pdf saying how rarely).
-  void set_probabilities(const std::vector<double>& weights);
-
-  // A direction towards one target (chosen by the 32-bit number u_choice), its
-  // pdf being the set's: sum over targets of probability * per-target pdf. The
-  // chosen target's density comes from its sampler, the others' from evaluation.
-  DirectionSample sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const;
-  float pdf(const Vec3& origin, const Vec3& direction) const;
-
- private:
-  float pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const;
-};
-
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
 // distribution, and the target sets. Built once per render; it points into the
 // scene, which must outlive it and stay where it is.
@@ -122,10 +86,12 @@ struct SamplingPlan {
   // The mixture's pdf for any unit direction.
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
 
+  // The steps of make, once `scene` is set: the target sets; then either
+  // nee-mis's one material sample, or the strategy's techniques with their
+  // realised shares.
+  void bind_targets();
+  void use_material_sample_only();
+  void set_technique_choice(const Strategy& strategy);
 };
-
-// How much light an emitter sends out (luminance of emit * area * pi, doubled
-// when two-sided): the weight for choosing it in proportion to its power.
-double emitter_power(const Material& m, double area);
 
 }  // namespace pdflab

@@ -99,7 +99,7 @@ TEST(LogAxis, SnapsToDecades) {
   EXPECT_DOUBLE_EQ(r.lo, 0.01);
   EXPECT_DOUBLE_EQ(r.hi, 10.0);
   EXPECT_NEAR(r.position(0.1), 1.0 / 3.0, 1e-12);
-  const auto ticks = decade_ticks(r);
+  const auto ticks = decade_ticks(r.lo, r.hi);
   ASSERT_EQ(ticks.size(), 4u);
   EXPECT_DOUBLE_EQ(ticks[0], 0.01);
   EXPECT_DOUBLE_EQ(ticks[3], 10.0);

@@ -325,7 +325,9 @@ TEST(PlotMath, AxesTicksAndColours) {
 
   EXPECT_EQ(draw::tick_label(0.0), "0");
   EXPECT_EQ(draw::tick_label(0.5), "0.5");
-  EXPECT_EQ(draw::tick_label(1e-3), "1e-03");
+  EXPECT_EQ(draw::tick_label(1e-3), "0.001");
+  EXPECT_EQ(draw::tick_label(1e-4), "1e-04");
+  EXPECT_EQ(draw::tick_label(2.5e4), "2e+04");
 
   // The colour map brightens monotonically (reads in grey too).
   float last = -1.0f;

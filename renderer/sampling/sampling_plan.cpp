@@ -1,0 +1,106 @@
+#include "renderer/sampling/strategy.h"
+
+#include "renderer/sampling/mixture.h"
+
+#include "renderer/error.h"
+
+#include <cstdio>
+
+namespace pdflab {
+
+namespace {
+
+// The strategy's weights, less those of techniques that aim at targets when
+// the scene has none (their weight goes to the others, renormalised by the
+// choice). Throws when no weight is left.
+std::array<double, kTechniqueCount> usable_weights(const Strategy& strategy, const Scene& scene, int target_count) {
+  std::array<double, kTechniqueCount> w{};
+  double total = 0.0;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const bool aims_at_nothing = target_count == 0 && technique_info(static_cast<Technique>(i)).draws_target;
+    w[i] = aims_at_nothing ? 0.0 : strategy.weights[i];
+    total += w[i];
+  }
+  if (!(total > 0.0))
+    throw InputError("strategy '" + strategy.to_string() + "' samples only the importance targets, but scene '" +
+                     scene.name + "' has none");
+  return w;
+}
+
+// The choice is made by a 32-bit number against thresholds fixed here, and
+// the mixture's pdf uses the shares those thresholds realise: the sampler and
+// the pdf agree exactly, for any weight down to 2^-32 of the total. A float
+// compared with a float CDF realised 1e-9 as 0 or 2^-24 while the pdf divided
+// by 1e-9 (an image 45 times too bright); below 2^-32 there is no share to give.
+DiscreteDistribution technique_choice(const Strategy& strategy, const std::array<double, kTechniqueCount>& w) {
+  DiscreteDistribution choice(w, DiscreteDistribution::Tiny::Zero);
+  if (!choice.zero_positive().empty()) {
+    const int i = choice.zero_positive().front();
+    double total = 0.0;
+    for (double x : w) total += x;
+    char share[32];
+    std::snprintf(share, sizeof share, "%.3g", w[i] / total);
+    throw InputError("strategy '" + strategy.to_string() + "': " +
+                     std::string(technique_info(static_cast<Technique>(i)).name) + "'s share " + share +
+                     " of the weights is below 2^-32 (2.3e-10), the smallest probability the sampler can give a "
+                     "technique; use 0 or a larger weight");
+  }
+  return choice;
+}
+
+}  // namespace
+
+void SamplingPlan::bind_targets() {
+  book_targets = book_target_set(*scene);
+  power_targets = power_target_set(*scene);
+  emitters = emitter_set(*scene);
+  target_count = book_targets.size();
+}
+
+void SamplingPlan::use_material_sample_only() {
+  weight[static_cast<int>(Technique::Cosine)] = 1.0f;  // nee-mis's material sample
+  last_technique = static_cast<int>(Technique::Cosine);
+  uses_frame = true;
+}
+
+void SamplingPlan::set_technique_choice(const Strategy& strategy) {
+  parameter = strategy.parameters;
+  const DiscreteDistribution choice = technique_choice(strategy, usable_weights(strategy, *scene, target_count));
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    weight[i] = choice.pmf(i);
+    choice_threshold[i] = choice.thresholds()[static_cast<std::size_t>(i)];
+  }
+  last_technique = choice.last_positive();
+#define PDFLAB_ROW(T) \
+  uses_frame = uses_frame || (leaf::uses_frame<leaf::T>() && weight[static_cast<int>(Technique::T)] > 0.0f);
+  PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
+}
+
+SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
+  SamplingPlan plan;
+  plan.scene = &scene;
+  plan.nee_mis = strategy.nee_mis;
+  plan.heuristic = strategy.heuristic;
+  plan.bind_targets();
+  if (strategy.nee_mis) plan.use_material_sample_only();
+  else plan.set_technique_choice(strategy);
+  return plan;
+}
+
+float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const {
+  return leaf::mixture_pdf(*this, leaf::Shading(*this, origin, normal, 0.0f, 0.0f, 0), direction, true);
+}
+
+DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
+  const auto u0 = static_cast<std::int32_t>(rng.next_u32());
+  const float u1 = rng.uniform();
+  const float u2 = rng.uniform();
+  const int chosen = leaf::choose_technique(*this, u0);
+  if (technique) *technique = chosen;
+  const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(rng.next_u32()) : 0;
+  return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
+}
+
+}  // namespace pdflab
+

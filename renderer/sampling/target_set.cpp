@@ -1,0 +1,135 @@
+#include "renderer/sampling/target_set.h"
+
+#include "renderer/sampling/techniques.h"
+
+#include <numbers>
+
+namespace pdflab {
+
+double emitter_power(const Material& m, double area) {
+  if (m.type != MaterialType::DiffuseLight) return 0.0;
+  return luminance(m.emit.x, m.emit.y, m.emit.z) * area * std::numbers::pi * (m.two_sided ? 2.0 : 1.0);
+}
+
+void TargetSet::set_probabilities(const std::vector<double>& weights) {
+  if (weights.empty()) {
+    choice = DiscreteDistribution();
+    return;
+  }
+  choice = DiscreteDistribution(weights, DiscreteDistribution::Tiny::AtLeastOne);
+  int i = 0;
+  for (auto& q : quads) q.probability = choice.pmf(i++);
+  for (auto& sp : spheres) sp.probability = choice.pmf(i++);
+}
+
+float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const {
+  float sum = 0.0f;
+  if (solid_angle) {
+    for (const QuadEntry& e : quads)
+      if (e.quad != skip) sum += e.probability * quad_solid_angle_pdf(*e.quad, origin, direction);
+  } else {
+    for (const QuadEntry& e : quads)
+      if (e.quad != skip) sum += e.probability * quad_area_pdf(*e.quad, origin, direction);
+  }
+  for (const SphereEntry& e : spheres)
+    if (e.sphere != skip) sum += e.probability * sphere_cone_pdf(*e.sphere, origin, direction);
+  return sum;
+}
+
+float TargetSet::pdf(const Vec3& origin, const Vec3& direction) const { return pdf_without(origin, direction, nullptr); }
+
+DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const {
+  if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at
+  const int chosen = choice.sample(u_choice);
+  DirectionSample ds;
+  const int nq = static_cast<int>(quads.size());
+  if (chosen < nq) {
+    const QuadEntry& e = quads[chosen];
+    ds = solid_angle ? sample_quad_solid_angle(*e.quad, origin, u1, u2) : sample_quad_area(*e.quad, origin, u1, u2);
+    if (ds.none) return ds;
+    ds.aimed_quad = e.index;
+    ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.quad);
+  } else {
+    const SphereEntry& e = spheres[chosen - nq];
+    ds = sample_sphere_cone(*e.sphere, origin, u1, u2);
+    ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.sphere);
+  }
+  return ds;
+}
+
+namespace {
+
+// Fills a set with the scene's objects that `pick` accepts; returns their powers.
+template <class Pick>
+std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pick) {
+  std::vector<double> quad_power, sphere_power;
+  for (std::size_t i = 0; i < scene.quads.size(); ++i) {
+    const Quad& q = scene.quads[i];
+    if (!pick(Target{Target::Kind::Quad, static_cast<std::uint32_t>(i)})) continue;
+    set.quads.push_back({&q, 0.0f, static_cast<std::int32_t>(i)});
+    quad_power.push_back(emitter_power(scene.materials[q.material], q.area));
+  }
+  for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+    const Sphere& sp = scene.spheres[i];
+    if (!pick(Target{Target::Kind::Sphere, static_cast<std::uint32_t>(i)})) continue;
+    set.spheres.push_back({&sp, 0.0f});
+    const double area = 4.0 * std::numbers::pi * static_cast<double>(sp.radius) * sp.radius;
+    sphere_power.push_back(emitter_power(scene.materials[sp.material], area));
+  }
+  quad_power.insert(quad_power.end(), sphere_power.begin(), sphere_power.end());
+  return quad_power;
+}
+
+// Power-proportional choice; a target that emits nothing (the book's glass
+// sphere) gets the mean emitter's share, so it is still aimed at as often as
+// an average light. All-zero powers fall back to uniform.
+std::vector<double> power_weights(std::vector<double> power) {
+  double sum = 0.0;
+  int emitting = 0;
+  for (double p : power)
+    if (p > 0.0) sum += p, ++emitting;
+  const double stand_in = emitting ? sum / emitting : 1.0;
+  for (double& p : power)
+    if (!(p > 0.0)) p = stand_in;
+  return power;
+}
+
+bool is_importance_target(const Scene& scene, const Target& t) {
+  for (const Target& x : scene.targets)
+    if (x.kind == t.kind && x.index == t.index) return true;
+  return false;
+}
+
+bool is_emitter(const Scene& scene, const Target& t) {
+  const std::uint32_t m = t.kind == Target::Kind::Quad ? scene.quads[t.index].material : scene.spheres[t.index].material;
+  return scene.materials[m].type == MaterialType::DiffuseLight;
+}
+
+}  // namespace
+
+TargetSet book_target_set(const Scene& scene) {
+  TargetSet set;
+  const std::size_t n =
+      collect_targets(scene, set, [&](const Target& t) { return is_importance_target(scene, t); }).size();
+  set.set_probabilities(std::vector<double>(n, 1.0));
+  return set;
+}
+
+TargetSet power_target_set(const Scene& scene) {
+  TargetSet set;
+  const std::vector<double> power =
+      collect_targets(scene, set, [&](const Target& t) { return is_importance_target(scene, t); });
+  set.solid_angle = true;
+  set.set_probabilities(power_weights(power));
+  return set;
+}
+
+TargetSet emitter_set(const Scene& scene) {
+  TargetSet set;
+  const std::vector<double> power = collect_targets(scene, set, [&](const Target& t) { return is_emitter(scene, t); });
+  set.solid_angle = true;
+  set.set_probabilities(power_weights(power));
+  return set;
+}
+
+}  // namespace pdflab

@@ -1,0 +1,120 @@
+#include "ui/colour_scale.h"
+
+#include "renderer/integrator/integrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pdflab::ui {
+
+double LogRange::position(double v) const {
+  if (!(v > 0.0)) return 0.0;
+  return (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo));
+}
+
+LogRange log_range(const std::vector<double>& values) {
+  double mn = 0.0, mx = 0.0;
+  bool any = false;
+  for (double v : values) {
+    if (!(v > 0.0) || !std::isfinite(v)) continue;
+    mn = any ? std::min(mn, v) : v;
+    mx = any ? std::max(mx, v) : v;
+    any = true;
+  }
+  if (!any) return {};
+  LogRange r;
+  // A tiny epsilon keeps an exact power of ten on its own decade.
+  r.lo = std::pow(10.0, std::floor(std::log10(mn) + 1e-9));
+  r.hi = std::pow(10.0, std::ceil(std::log10(mx) - 1e-9));
+  if (r.hi <= r.lo) r.hi = r.lo * 10.0;
+  return r;
+}
+
+namespace {
+
+Colour lerp_stops(const Colour* stops, int count, double t) {
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * (count - 1);
+  const int i = std::min(static_cast<int>(t), count - 2);
+  const float f = static_cast<float>(t - i);
+  Colour c;
+  for (int k = 0; k < 3; ++k) c[k] = stops[i][k] + (stops[i + 1][k] - stops[i][k]) * f;
+  return c;
+}
+
+}  // namespace
+
+Colour sequential_colour(double t) {
+  // Hand-placed stops, lightness rising steadily from near black to pale yellow.
+  static constexpr Colour kStops[] = {{0.02f, 0.01f, 0.08f}, {0.23f, 0.06f, 0.43f}, {0.52f, 0.13f, 0.50f},
+                                      {0.82f, 0.25f, 0.38f}, {0.98f, 0.52f, 0.25f}, {0.99f, 0.87f, 0.55f}};
+  return lerp_stops(kStops, 6, t);
+}
+
+Colour diverging_colour(double t) {
+  static constexpr Colour kStops[] = {{0.17f, 0.32f, 0.80f}, {0.55f, 0.68f, 0.95f}, {0.92f, 0.92f, 0.92f},
+                                      {0.95f, 0.60f, 0.48f}, {0.78f, 0.12f, 0.15f}};
+  return lerp_stops(kStops, 5, (std::clamp(std::isfinite(t) ? t : 0.0, -1.0, 1.0) + 1.0) * 0.5);
+}
+
+Colour drop_reason_colour(int reason) {
+  switch (static_cast<DropReason>(reason)) {
+    case DropReason::PdfZero: return {1.0f, 0.25f, 0.85f};            // magenta
+    case DropReason::PdfNotFinite: return {0.2f, 0.9f, 1.0f};         // cyan
+    case DropReason::RadianceNotFinite: return {1.0f, 0.85f, 0.1f};   // yellow
+    default: break;
+  }
+  return kSeveralDropReasonsColour;
+}
+
+double ColourScale::position(double v) const {
+  if (!std::isfinite(v)) return v > 0.0 ? 1.0 : 0.0;
+  double t;
+  if (diverging) t = (v / hi + 1.0) * 0.5;
+  else if (logarithmic) t = v > 0.0 ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : 0.0;
+  else t = (v - lo) / (hi - lo);
+  return std::clamp(t, 0.0, 1.0);
+}
+
+Colour ColourScale::colour(double v) const {
+  const double t = position(v);
+  return diverging ? diverging_colour(2.0 * t - 1.0) : sequential_colour(t);
+}
+
+std::vector<LegendTick> legend_ticks(const ColourScale& scale) {
+  std::vector<LegendTick> ticks;
+  if (scale.logarithmic && !scale.diverging) {
+    for (double v : decade_ticks(scale.lo, scale.hi)) ticks.push_back({scale.position(v), tick_label(v)});
+  } else if (scale.diverging) {
+    for (double f : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
+      std::string label = tick_label(f * scale.hi);
+      if (f > 0.0) label = "+" + label;
+      ticks.push_back({scale.position(f * scale.hi), label});
+    }
+  } else {
+    for (int i = 0; i <= 4; ++i) {
+      const double v = scale.lo + (scale.hi - scale.lo) * i / 4.0;
+      ticks.push_back({scale.position(v), tick_label(v)});
+    }
+  }
+  return ticks;
+}
+
+ColourScale relative_error_scale() {
+  ColourScale s;
+  s.logarithmic = true;
+  s.lo = 1e-3;
+  s.hi = 10.0;
+  s.title = "relative standard error per pixel (log)";
+  return s;
+}
+
+ColourScale difference_scale(double half_range) {
+  ColourScale s;
+  s.diverging = true;
+  s.hi = half_range > 0.0 && std::isfinite(half_range) ? half_range : 1.0;
+  s.lo = -s.hi;
+  s.title = "luminance: image - reference";
+  return s;
+}
+
+}  // namespace pdflab::ui
