@@ -694,6 +694,7 @@ void Viewer::Impl::on_key(int key, int mods) {
       apply_render_settings();
       break;
     case GLFW_KEY_V: settings.measure.view_mode = ui::next_view_mode(settings.measure.view_mode); break;
+    case GLFW_KEY_E: settings.measure.step_metric(mods & GLFW_MOD_SHIFT ? -1 : 1); break;
     case GLFW_KEY_G: settings.measure.show_plot = !settings.measure.show_plot; break;
     case GLFW_KEY_M:  // make a reference, as the Measure section's button; again: cancel
       if (references->running()) references->cancel(measure);
@@ -994,7 +995,7 @@ void Viewer::Impl::upload_textures() {
     display->upload(image.data(), image_info.data_width, image_info.data_height);
     texture_stale = false;
   }
-  if (measure.refresh_layer(settings.measure.view_mode))
+  if (measure.refresh_layer(settings.measure))
     view_texture->upload(measure.layer.rgba.data(), measure.layer.width, measure.layer.height);
 }
 

@@ -83,7 +83,24 @@ Colour ColourScale::colour(double v) const {
 std::vector<LegendTick> legend_ticks(const ColourScale& scale) {
   std::vector<LegendTick> ticks;
   if (scale.logarithmic && !scale.diverging) {
-    for (double v : decade_ticks(scale.lo, scale.hi)) ticks.push_back({scale.position(v), tick_label(v)});
+    // Both ends, and round values between them: the decades, or 1-2-5 steps
+    // when the range spans less than two decades. None crowds an end.
+    const double l0 = std::log10(scale.lo), l1 = std::log10(scale.hi);
+    const bool few_decades = l1 - l0 < 2.0 - 1e-9;
+    static constexpr double kSteps[] = {1.0, 2.0, 5.0};
+    std::vector<double> inner;
+    for (int e = static_cast<int>(std::floor(l0)) - 1; e <= static_cast<int>(std::ceil(l1)); ++e)
+      for (int k = 0; k < (few_decades ? 3 : 1); ++k) {
+        const double v = kSteps[k] * std::pow(10.0, e);
+        const double t = scale.position(v);
+        if (v > scale.lo * (1.0 + 1e-9) && v < scale.hi * (1.0 - 1e-9) && t > 0.12 && t < 0.88) inner.push_back(v);
+      }
+    // At most five between the ends: every other one (or third...) of a long run.
+    std::size_t step = 1;
+    while (inner.size() / step > 5) ++step;
+    ticks.push_back({0.0, tick_label(scale.lo)});
+    for (std::size_t i = 0; i < inner.size(); i += step) ticks.push_back({scale.position(inner[i]), tick_label(inner[i])});
+    ticks.push_back({1.0, tick_label(scale.hi)});
   } else if (scale.diverging) {
     for (double f : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
       std::string label = tick_label(f * scale.hi);

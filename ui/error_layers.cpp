@@ -2,6 +2,7 @@
 
 #include "renderer/integrator/integrator.h"
 #include "renderer/math.h"
+#include "renderer/metrics/metrics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,6 +28,63 @@ ViewMode next_view_mode(ViewMode mode) {
   return static_cast<ViewMode>((static_cast<int>(mode) + 1) % kViewModeCount);
 }
 
+const char* error_metric_label(ViewMode mode, ErrorMetric metric) {
+  if (mode == ViewMode::RelativeError) {
+    switch (metric) {
+      case ErrorMetric::Absolute: return "standard error (absolute)";
+      case ErrorMetric::Squared: return "variance of the mean (squared)";
+      case ErrorMetric::Relative: return "relative standard error";
+      case ErrorMetric::RelativeSquared: return "relative variance (relative squared)";
+      default: return "?";
+    }
+  }
+  switch (metric) {
+    case ErrorMetric::Signed: return "error (signed)";
+    case ErrorMetric::Absolute: return "absolute error";
+    case ErrorMetric::Squared: return "squared error";
+    case ErrorMetric::Relative: return "relative absolute error";
+    case ErrorMetric::RelativeSquared: return "relative squared error";
+    case ErrorMetric::Count: break;
+  }
+  return "?";
+}
+
+bool view_offers_metric(ViewMode mode, ErrorMetric metric) {
+  if (metric == ErrorMetric::Count) return false;
+  return mode == ViewMode::Difference || (mode == ViewMode::RelativeError && metric != ErrorMetric::Signed);
+}
+
+ViewRange sanitized(const ViewRange& range, bool signed_metric) {
+  ViewRange r = range;
+  const auto usable = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (signed_metric) {
+    if (!usable(r.hi)) r.hi = 1.0;
+    r.lo = -r.hi;
+    return r;
+  }
+  if (!usable(r.lo) && !usable(r.hi)) r = {r.automatic, 1e-3, 1.0};
+  if (!usable(r.lo)) r.lo = r.hi / 1e3;
+  if (!usable(r.hi)) r.hi = r.lo * 1e3;
+  if (r.lo > r.hi) std::swap(r.lo, r.hi);
+  r.lo = std::max(r.lo, 1e-30);
+  if (!(r.hi > r.lo * (1.0 + 1e-6))) r.hi = r.lo * 10.0;
+  return r;
+}
+
+LayerOptions default_heat_map_options() {
+  LayerOptions o;
+  o.metric = ErrorMetric::Relative;
+  o.range = {false, 1e-3, 10.0};
+  return o;
+}
+
+LayerOptions default_difference_options() {
+  LayerOptions o;
+  o.metric = ErrorMetric::Signed;
+  o.range = {true, 1e-3, 1.0};
+  return o;
+}
+
 
 std::string reference_size_mismatch(const ReferenceImage& reference, int render_width, int render_height) {
   if (!reference.loaded() || (reference.width == render_width && reference.height == render_height)) return {};
@@ -48,28 +106,122 @@ void put(std::vector<std::uint8_t>& rgba, std::size_t pixel, const Colour& c, st
   p[3] = alpha;
 }
 
+float metric_value(ErrorMetric metric, double error, double value) {
+  const double e = std::abs(error);
+  switch (metric) {
+    case ErrorMetric::Signed: return static_cast<float>(error);
+    case ErrorMetric::Absolute: return static_cast<float>(e);
+    case ErrorMetric::Squared: return static_cast<float>(e * e);
+    case ErrorMetric::Relative: return static_cast<float>(e / (std::abs(value) + kRelMseEpsilon));
+    case ErrorMetric::RelativeSquared: return static_cast<float>(e * e / (value * value + kRelMseEpsilon));
+    case ErrorMetric::Count: break;
+  }
+  return 0.0f;
+}
+
+// The `q` quantile of the finite values (positive ones only if `positive`); NaN when there is none.
+double quantile(const std::vector<float>& values, double q, bool positive) {
+  std::vector<float> a;
+  a.reserve(values.size());
+  for (float v : values)
+    if (std::isfinite(v) && (!positive || v > 0.0f)) a.push_back(v);
+  if (a.empty()) return NAN;
+  const std::size_t k = std::min(a.size() - 1, static_cast<std::size_t>(q * static_cast<double>(a.size())));
+  std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(k), a.end());
+  return a[k];
+}
+
+const char* metric_title(ViewMode mode, ErrorMetric metric) {
+  if (mode == ViewMode::RelativeError) {
+    switch (metric) {
+      case ErrorMetric::Absolute: return "standard error of the mean, luminance (log)";
+      case ErrorMetric::Squared: return "variance of the mean, luminance (log)";
+      case ErrorMetric::RelativeSquared: return "variance / (mean + 0.01)^2 per pixel (log)";
+      default: return "relative standard error per pixel (log)";
+    }
+  }
+  switch (metric) {
+    case ErrorMetric::Signed: return "luminance: image - reference";
+    case ErrorMetric::Absolute: return "|image - reference|, luminance (log)";
+    case ErrorMetric::Squared: return "(image - reference)^2, luminance (log)";
+    case ErrorMetric::Relative: return "|image - reference| / (reference + 0.01) (log)";
+    case ErrorMetric::RelativeSquared: return "(image - reference)^2 / (reference^2 + 0.01) (log)";
+    case ErrorMetric::Count: break;
+  }
+  return "?";
+}
+
 }  // namespace
 
 std::vector<float> luminance_difference(const std::vector<float>& rgb, const std::vector<float>& reference) {
-  std::vector<float> d(std::min(rgb.size(), reference.size()) / 3);
-  for (std::size_t p = 0; p < d.size(); ++p)
-    d[p] = static_cast<float>(luminance(&rgb[3 * p]) - luminance(&reference[3 * p]));
-  return d;
+  return difference_values(rgb, reference, ErrorMetric::Signed);
 }
 
 double difference_half_range(const std::vector<float>& difference) {
-  std::vector<float> a;
-  a.reserve(difference.size());
-  for (float v : difference)
-    if (std::isfinite(v)) a.push_back(std::abs(v));
-  if (a.empty()) return 1.0;
-  const std::size_t k = std::min(a.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(a.size())));
-  std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(k), a.end());
-  return nice_ceiling(std::max(a[k], 1e-6f));
+  std::vector<float> a(difference.size());
+  std::transform(difference.begin(), difference.end(), a.begin(), [](float v) { return std::abs(v); });
+  const double q = quantile(a, 0.99, false);
+  return std::isfinite(q) ? nice_ceiling(std::max(q, 1e-6)) : 1.0;
+}
+
+std::vector<float> heat_map_values(const PublishedImage& image, ErrorMetric metric) {
+  const std::vector<float>& rse = image.relative_standard_error;
+  std::vector<float> v(rse.size());
+  const bool have_mean = image.rgb.size() >= 3 * rse.size();
+  for (std::size_t p = 0; p < v.size(); ++p) {
+    // The map is sqrt(variance of the mean) / (mean + 0.01), of the luminance (metrics.h).
+    const double mean = have_mean ? luminance(&image.rgb[3 * p]) : 0.0;
+    const double standard_error = static_cast<double>(rse[p]) * (mean + kRelMseEpsilon);
+    switch (metric) {
+      case ErrorMetric::Absolute: v[p] = static_cast<float>(standard_error); break;
+      case ErrorMetric::Squared: v[p] = static_cast<float>(standard_error * standard_error); break;
+      case ErrorMetric::RelativeSquared: v[p] = rse[p] * rse[p]; break;
+      default: v[p] = rse[p]; break;
+    }
+  }
+  return v;
+}
+
+std::vector<float> difference_values(const std::vector<float>& rgb, const std::vector<float>& reference,
+                                     ErrorMetric metric) {
+  std::vector<float> v(std::min(rgb.size(), reference.size()) / 3);
+  for (std::size_t p = 0; p < v.size(); ++p) {
+    const double r = luminance(&reference[3 * p]);
+    v[p] = metric_value(metric, luminance(&rgb[3 * p]) - r, r);
+  }
+  return v;
+}
+
+ColourScale error_scale(ViewMode mode, const LayerOptions& options, const std::vector<float>& values) {
+  const bool signed_metric = options.metric == ErrorMetric::Signed && mode == ViewMode::Difference;
+  ViewRange range = sanitized(options.range, signed_metric);
+  ColourScale s;
+  if (signed_metric) {
+    s = difference_scale(range.automatic ? difference_half_range(values) : range.hi);
+  } else {
+    if (range.automatic) {
+      const double hi = quantile(values, 0.99, true), lo = quantile(values, 0.01, true);
+      if (std::isfinite(hi)) {
+        range.hi = nice_ceiling(hi);
+        range.lo = std::clamp(nice_floor(lo), range.hi * 1e-6, range.hi / 10.0);
+      } else {
+        range.lo = 1e-3;
+        range.hi = 1.0;
+      }
+    }
+    s.logarithmic = true;
+    s.lo = range.lo;
+    s.hi = range.hi;
+  }
+  s.title = metric_title(mode, options.metric);
+  return s;
 }
 
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why) {
+                      std::string& why, const LayerOptions* given) {
+  const LayerOptions options = given ? *given
+                                     : (mode == ViewMode::Difference ? default_difference_options()
+                                                                     : default_heat_map_options());
   const ImageInfo& info = image.info;
   const std::size_t pixels = static_cast<std::size_t>(info.width) * static_cast<std::size_t>(info.height);
   if (mode == ViewMode::Image) return false;
@@ -87,8 +239,9 @@ bool build_view_layer(ViewMode mode, const PublishedImage& image, const Referenc
         why = "the noise estimate needs 2 samples per pixel";
         return false;
       }
-      out.scale = relative_error_scale();
-      for (std::size_t p = 0; p < pixels; ++p) put(out.rgba, p, out.scale.colour(image.relative_standard_error[p]), 255);
+      const std::vector<float> v = heat_map_values(image, options.metric);
+      out.scale = error_scale(mode, options, v);
+      for (std::size_t p = 0; p < pixels; ++p) put(out.rgba, p, out.scale.colour(v[p]), 255);
       return true;
     }
     case ViewMode::Difference: {
@@ -100,8 +253,8 @@ bool build_view_layer(ViewMode mode, const PublishedImage& image, const Referenc
         why = reference_size_mismatch(*reference, info.width, info.height);
         return false;
       }
-      const std::vector<float> d = luminance_difference(image.rgb, reference->rgb);
-      out.scale = difference_scale(difference_half_range(d));
+      const std::vector<float> d = difference_values(image.rgb, reference->rgb, options.metric);
+      out.scale = error_scale(mode, options, d);
       for (std::size_t p = 0; p < pixels; ++p) put(out.rgba, p, out.scale.colour(d[p]), 255);
       return true;
     }

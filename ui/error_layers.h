@@ -17,6 +17,35 @@ inline constexpr int kViewModeCount = static_cast<int>(ViewMode::Count);
 const char* view_mode_label(ViewMode mode);
 ViewMode next_view_mode(ViewMode mode);
 
+// The per-pixel error a false-colour view shows, chosen as in tev: the signed
+// error, its absolute value or square, and those relative to the value (over
+// value + 0.01, and value^2 + 0.01 as relMSE has it). The heat map's error is
+// the noise of the mean (its standard error), so it has no sign.
+enum class ErrorMetric : std::uint8_t { Signed, Absolute, Squared, Relative, RelativeSquared, Count };
+inline constexpr int kErrorMetricCount = static_cast<int>(ErrorMetric::Count);
+const char* error_metric_label(ViewMode mode, ErrorMetric metric);
+bool view_offers_metric(ViewMode mode, ErrorMetric metric);
+
+// A view's value range: from the image (its 1st and 99th percentiles, made
+// round) or as set. A signed metric uses `hi` alone, for -hi..hi; the others
+// are drawn on a log scale from `lo` to `hi`.
+struct ViewRange {
+  bool automatic = true;
+  double lo = 1e-3, hi = 10.0;
+  bool operator==(const ViewRange&) const = default;
+};
+// A usable range: positive, lo below hi, finite (a typed 0 or a swapped pair is fixed).
+ViewRange sanitized(const ViewRange& range, bool signed_metric);
+struct LayerOptions {
+  ErrorMetric metric = ErrorMetric::Relative;
+  ViewRange range;
+  bool operator==(const LayerOptions&) const = default;
+};
+// The heat map starts on the relative standard error over a fixed 0.001..10,
+// so two strategies' maps compare; the difference view on the signed error, its range automatic.
+LayerOptions default_heat_map_options();
+LayerOptions default_difference_options();
+
 // The reference (renderer/metrics/reference.h): mean, variance, sidecar.
 using ReferenceImage = pdflab::Reference;
 
@@ -28,6 +57,15 @@ std::vector<float> luminance_difference(const std::vector<float>& rgb, const std
 // A half range for the difference view: the 99th percentile of |d|, made nice,
 // so a few fireflies do not wash the rest out.
 double difference_half_range(const std::vector<float>& difference);
+// The values a view shows for `metric`, one per pixel, from the luminance of
+// the image, of the reference, and of the film's noise (the heat map: the
+// standard error of the mean is the relative one times (mean + 0.01)).
+std::vector<float> heat_map_values(const PublishedImage& image, ErrorMetric metric);
+std::vector<float> difference_values(const std::vector<float>& rgb, const std::vector<float>& reference,
+                                     ErrorMetric metric);
+// The colour scale of `values` under `options`: diverging and linear for the
+// signed error, else logarithmic; an automatic range from the values.
+ColourScale error_scale(ViewMode mode, const LayerOptions& options, const std::vector<float>& values);
 
 // A false-colour layer as RGBA8, row 0 at the top, drawn over (Drops) or
 // instead of (the others) the image. Returns false with the reason in `why`
@@ -39,6 +77,6 @@ struct ViewLayer {
   std::array<std::uint64_t, 4> drop_pixels{};  // Drops: pixels per reason (+ several, last)
 };
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why);
+                      std::string& why, const LayerOptions* options = nullptr);  // null: the mode's defaults
 
 }  // namespace pdflab::ui

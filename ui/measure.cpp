@@ -79,11 +79,32 @@ void MeasureState::set_reference(ReferenceImage image) {
   layer_why.clear();
 }
 
-bool MeasureState::refresh_layer(ViewMode mode) {
-  if (mode == layer_mode && (layer_ok || !layer_why.empty() || mode == ViewMode::Image)) return false;
+void MeasureSettings::set_metric(ErrorMetric metric) {
+  LayerOptions& o = layer_options(view_mode);
+  if (!view_offers_metric(view_mode, metric) || o.metric == metric) return;
+  o.metric = metric;
+  o.range.automatic = true;
+}
+
+void MeasureSettings::step_metric(int step) {
+  if (view_mode != ViewMode::RelativeError && view_mode != ViewMode::Difference) return;
+  int m = static_cast<int>(layer_options(view_mode).metric);
+  for (int i = 0; i < kErrorMetricCount; ++i) {
+    m = ((m + step) % kErrorMetricCount + kErrorMetricCount) % kErrorMetricCount;
+    if (view_offers_metric(view_mode, static_cast<ErrorMetric>(m))) break;
+  }
+  set_metric(static_cast<ErrorMetric>(m));
+}
+
+bool MeasureState::refresh_layer(const MeasureSettings& settings) {
+  const ViewMode mode = settings.view_mode;
+  const LayerOptions& options = settings.layer_options(mode);
+  if (mode == layer_mode && (mode == ViewMode::Image || (options == layer_options && (layer_ok || !layer_why.empty()))))
+    return false;
   layer_mode = mode;
+  layer_options = options;
   layer_why.clear();
-  layer_ok = build_view_layer(mode, published, &reference, layer, layer_why);
+  layer_ok = build_view_layer(mode, published, &reference, layer, layer_why, &options);
   return layer_ok;
 }
 

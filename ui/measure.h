@@ -22,6 +22,15 @@ namespace pdflab::ui {
 // The measuring part of ViewerSettings.
 struct MeasureSettings {
   ViewMode view_mode = ViewMode::Image;
+  LayerOptions heat_map = default_heat_map_options();
+  LayerOptions difference = default_difference_options();
+  // The options of `mode` (the heat map's for a mode without any).
+  const LayerOptions& layer_options(ViewMode mode) const { return mode == ViewMode::Difference ? difference : heat_map; }
+  LayerOptions& layer_options(ViewMode mode) { return mode == ViewMode::Difference ? difference : heat_map; }
+  // The current view's metric (E, Shift+E: step -1): the next one it offers,
+  // on an automatic range (the old range belongs to another quantity).
+  void set_metric(ErrorMetric metric);
+  void step_metric(int step);
   bool show_plot = false;  // G shows it; off at first so the image is seen whole
   bool plot_against_spp = false;  // false: against rendering seconds
   std::string reference_field;    // the path as typed
@@ -102,6 +111,7 @@ struct MeasureState {
   ConvergenceRecorder curves;
   PublishedImage published;     // the image on screen with its noise map and drop mask
   ViewMode layer_mode = ViewMode::Image;
+  LayerOptions layer_options;   // what `layer` was built with
   bool layer_ok = false;        // `layer` shows `layer_mode` for `published`
   std::string layer_why;        // why not, when the mode is not Image
   ViewLayer layer;
@@ -111,8 +121,14 @@ struct MeasureState {
   void on_image(std::uint64_t current_generation, const std::string& label);
   // A new reference (or none): figures and layer follow at once.
   void set_reference(ReferenceImage image);
-  // Rebuilds the layer for `mode`; true when it changed (and must be uploaded).
-  bool refresh_layer(ViewMode mode);
+  // Rebuilds the layer for the view mode and its options when either or the
+  // image changed; true when it did (and must be uploaded).
+  bool refresh_layer(const MeasureSettings& settings);
+  bool refresh_layer(ViewMode mode) {
+    MeasureSettings s;
+    s.view_mode = mode;
+    return refresh_layer(s);
+  }
   // Size mismatch against the render, empty when none or no reference.
   std::string size_mismatch(int render_width, int render_height) const {
     return reference_size_mismatch(reference, render_width, render_height);

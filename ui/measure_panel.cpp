@@ -148,11 +148,13 @@ void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, c
       }
       ImGui::TextColored(kDim, total == 0 ? "No pixel dropped a sample." : "Other pixels are dimmed.");
     } else {
+      const LayerOptions& o = m.layer_options;
       ImGui::TextColored(kDim, "%s", m.layer.scale.title.c_str());
       draw_colour_bar(m.layer.scale, width);
-      if (mode == ViewMode::RelativeError)
+      ImGui::TextColored(kDim, "%s", o.range.automatic ? "range: auto (1st to 99th percentile)" : "range: as set in the panel");
+      if (mode == ViewMode::RelativeError && o.metric == ErrorMetric::Relative)
         ImGui::TextColored(kDim, "mean %.4f; per pixel: standard error of the mean / mean", m.figures.mean_relative_standard_error);
-      else
+      else if (mode == ViewMode::Difference && o.metric == ErrorMetric::Signed)
         ImGui::TextColored(kDim, "blue: darker than the reference, red: brighter");
     }
     ImGui::PopTextWrapPos();
@@ -306,6 +308,56 @@ void draw_view_mode_selector(ViewerSettings& settings) {
     ImGui::EndCombo();
   }
   settings.measure.view_mode = static_cast<ViewMode>(mode);
+}
+
+void draw_layer_controls(ViewerSettings& settings, const MeasureState* m) {
+  const ViewMode mode = settings.measure.view_mode;
+  if (mode != ViewMode::RelativeError && mode != ViewMode::Difference) return;
+  LayerOptions& o = settings.measure.layer_options(mode);
+  ImGui::Indent();
+  const float label_room = ImGui::CalcTextSize("Metric (E)").x + ImGui::GetStyle().ItemInnerSpacing.x;
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - label_room);
+  if (ImGui::BeginCombo("Metric (E)", error_metric_label(mode, o.metric))) {
+    for (int i = 0; i < kErrorMetricCount; ++i) {
+      const auto metric = static_cast<ErrorMetric>(i);
+      if (!view_offers_metric(mode, metric)) continue;
+      if (ImGui::Selectable(error_metric_label(mode, metric), o.metric == metric)) settings.measure.set_metric(metric);
+    }
+    ImGui::EndCombo();
+  }
+  const bool signed_metric = mode == ViewMode::Difference && o.metric == ErrorMetric::Signed;
+  bool automatic = o.range.automatic;
+  if (ImGui::Checkbox("auto range", &automatic)) {
+    // Set by hand from where the automatic range was, so nothing jumps.
+    if (!automatic && m && m->layer_ok && m->layer_mode == mode) {
+      o.range.lo = m->layer.scale.diverging ? -m->layer.scale.hi : m->layer.scale.lo;
+      o.range.hi = m->layer.scale.hi;
+    }
+    o.range.automatic = automatic;
+  }
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("On: from the 1st to the 99th percentile of this image's values, rounded.\n"
+                      "Off: fixed, so two strategies' maps compare. Ctrl+click a slider to type a value.");
+  ImGui::BeginDisabled(automatic);
+  const ImGuiSliderFlags log = ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp;
+  // An automatic range shows where it is now (and is not stored: the next image moves it).
+  const bool shown = automatic && m && m->layer_ok && m->layer_mode == mode;
+  float lo = static_cast<float>(shown ? m->layer.scale.lo : o.range.lo);
+  float hi = static_cast<float>(shown ? m->layer.scale.hi : o.range.hi);
+  if (signed_metric) {
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.6f);
+    if (ImGui::SliderFloat("+- range", &hi, 1e-6f, 1e6f, "%.3g", log)) o.range.hi = hi;
+  } else {
+    const float half = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) * 0.5f;
+    ImGui::SetNextItemWidth(half);
+    if (ImGui::SliderFloat("##range lo", &lo, 1e-9f, 1e6f, "min %.3g", log)) o.range.lo = std::min(lo, hi * 0.999f);
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(half);
+    if (ImGui::SliderFloat("##range hi", &hi, 1e-9f, 1e6f, "max %.3g", log)) o.range.hi = std::max(hi, lo * 1.001f);
+  }
+  ImGui::EndDisabled();
+  o.range = sanitized(o.range, signed_metric);
+  ImGui::Unindent();
 }
 
 void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {

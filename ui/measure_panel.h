@@ -16,6 +16,8 @@ struct ImageRect {
 
 void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests);
 void draw_view_mode_selector(ViewerSettings& settings);
+// The heat map's and difference view's metric and range (nothing for the other views).
+void draw_layer_controls(ViewerSettings& settings, const MeasureState* measure);
 // "How is this different?": nee-mis against the book's one-sample mixture.
 void draw_nee_explanation();
 // The false-colour layer (texture: ViewTexture::id, 0 for none), its legend,

@@ -228,7 +228,7 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
   ImGui::EndDisabled();
 }
 
-void display_section(ViewerSettings& settings, UiRequests& requests) {
+void display_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
   ImGui::SliderFloat("Exposure", &settings.exposure_ev, -6.0f, 6.0f, "%+.1f EV");
   if (ImGui::IsItemClicked(ImGuiMouseButton_Right)) settings.exposure_ev = 0.0f;
   int transfer = settings.srgb ? 1 : 0;
@@ -237,6 +237,7 @@ void display_section(ViewerSettings& settings, UiRequests& requests) {
   ImGui::RadioButton("sRGB", &transfer, 1);
   settings.srgb = transfer == 1;
   draw_view_mode_selector(settings);
+  draw_layer_controls(settings, status.measure);
   char scale[16];
   std::snprintf(scale, sizeof scale, "%.0f%%", settings.ui_scale * 100.0f);
   if (ImGui::BeginCombo("UI scale", scale)) {
@@ -371,7 +372,7 @@ void draw_side_panel(float width, float display_height, ViewerSettings& settings
     scene_section(settings, state, status, requests);
   if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics_section(settings, status);
   if (ImGui::CollapsingHeader("Measure", ImGuiTreeNodeFlags_DefaultOpen)) draw_measure_section(settings, status, requests);
-  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings, requests);
+  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings, status, requests);
   if (ImGui::CollapsingHeader("Screenshot", ImGuiTreeNodeFlags_DefaultOpen))
     screenshot_section(settings, status, requests);
   ImGui::PopItemWidth();
@@ -395,6 +396,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"3", "preset: book 50/50 (cosine + light)"},
         {"4", "next-event estimation (nee-mis)"},
         {"V", "next view: image, noise heat map, difference, drops"},
+        {"E, Shift+E", "next, previous error metric of the heat map or difference view"},
         {"G", "show / hide the convergence plot (graph)"},
         {"K", "keep (pin) the running convergence curve"},
         {"M", "make a reference (Measure section; M again cancels)"},

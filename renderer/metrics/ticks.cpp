@@ -13,6 +13,14 @@ double nice_ceiling(double v) {
   return 10.0 * decade;
 }
 
+double nice_floor(double v) {
+  if (!(v > 0.0) || !std::isfinite(v)) return 1.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(v)));
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * decade <= v) return m * decade;
+  return decade;
+}
+
 std::vector<double> nice_ticks(double lo, double hi, int max_ticks) {
   std::vector<double> ticks;
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || max_ticks < 2) return ticks;

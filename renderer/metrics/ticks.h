@@ -11,6 +11,9 @@ namespace pdflab {
 // as its own ceiling, or to leave headroom above it, scales v by 1 -/+ 1e-9.
 double nice_ceiling(double v);
 
+// The largest of 1, 2, 5 times a power of ten that is <= v (same conventions).
+double nice_floor(double v);
+
 // Ticks at multiples of a nice step covering [lo, hi], at most about `max_ticks`.
 std::vector<double> nice_ticks(double lo, double hi, int max_ticks = 6);
 

@@ -42,6 +42,47 @@ for i in "${!modes[@]}"; do
   convert "$art/window_${modes[$i]}.png" -crop "$crop" +repage "$art/${modes[$i]}.png"
 done
 send_key v   # back to the image
+
+echo "== the heat map's error metric (E) and its range (the panel)"
+send_key space   # paused: every change below is the control's doing
+sleep 1
+legend="300x150+$((area - 310))+0"
+# look NAME: the image area and the colour bar's window.
+look() {
+  sleep 1.5
+  shot "window_$1"
+  convert "$art/window_$1.png" -crop "$crop" +repage "$art/$1.png"
+  convert "$art/window_$1.png" -crop "$legend" +repage "$art/$1_legend.png"
+}
+send_key v
+look heat_fixed    # the relative standard error on the fixed 0.001..10
+send_key e
+look heat_relsq    # the relative variance, on its automatic range
+changed "$art/heat_fixed.png" "$art/heat_relsq.png" 0.02
+changed "$art/heat_fixed_legend.png" "$art/heat_relsq_legend.png" 0.01
+send_key shift+e
+look heat_auto     # the relative standard error again, on an automatic range
+changed "$art/heat_fixed.png" "$art/heat_auto.png" 0.02
+changed "$art/heat_fixed_legend.png" "$art/heat_auto_legend.png" 0.01
+# The panel scrolled to its end: the range controls sit at fixed places above its bottom.
+xdotool mousemove "$((area + 200))" "$((HEIGHT / 2))"
+for _ in $(seq 25); do xdotool click 5; sleep 0.03; done
+sleep 0.5
+shot panel_end "400x${HEIGHT}+${area}+0"
+xdotool mousemove "$((area + 39))" "$((HEIGHT - 198))" click 1   # auto range: off
+xdotool mousemove 2 2
+look heat_set      # set by hand where the automatic range was: nothing jumps
+same "$art/heat_auto.png" "$art/heat_set.png" 0.01
+changed "$art/heat_auto_legend.png" "$art/heat_set_legend.png" 0.002  # "range: as set in the panel"
+xdotool mousemove "$((area + 215))" "$((HEIGHT - 173))" click 1   # the max slider, near its low end
+xdotool mousemove 2 2
+look heat_low_max  # a lower top: more pixels at the bright end
+changed "$art/heat_set.png" "$art/heat_low_max.png" 0.02
+changed "$art/heat_set_legend.png" "$art/heat_low_max_legend.png" 0.01
+read -r mean_set <<<"$(identify -format "%[fx:mean]" "$art/heat_set.png")"
+read -r mean_low <<<"$(identify -format "%[fx:mean]" "$art/heat_low_max.png")"
+echo "heat map mean brightness: $mean_set, with the lower top $mean_low"
+awk -v a="$mean_set" -v b="$mean_low" 'BEGIN { exit !(b > a) }' || fail "a lower top did not brighten the heat map"
 quit_viewer
 
 for m in "${modes[@]}"; do

@@ -176,6 +176,174 @@ TEST(ColourMaps, DifferenceLegendIsSymmetricAndNice) {
   EXPECT_NEAR(diff[1], -0.0722f, 1e-6f);
 }
 
+TEST(ErrorMetrics, DifferenceValuesFollowTheirDefinitions) {
+  // Grey image 0.6 against grey reference 0.4 (luminance = the grey), and 0.1 against 0.4.
+  const std::vector<float> image = {0.6f, 0.6f, 0.6f, 0.1f, 0.1f, 0.1f}, reference(6, 0.4f);
+  const auto at = [&](ErrorMetric m) { return difference_values(image, reference, m); };
+  EXPECT_NEAR(at(ErrorMetric::Signed)[0], 0.2, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::Signed)[1], -0.3, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::Absolute)[1], 0.3, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::Squared)[0], 0.04, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::Squared)[1], 0.09, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::Relative)[0], 0.2 / 0.41, 1e-6);
+  EXPECT_NEAR(at(ErrorMetric::RelativeSquared)[1], 0.09 / (0.16 + 0.01), 1e-6);
+  // Averaged over channels of a grey image, the relative squared error is relMSE's term.
+  EXPECT_NEAR(at(ErrorMetric::RelativeSquared)[0], relmse({0.6f, 0.6f, 0.6f}, {0.4f, 0.4f, 0.4f}), 1e-6);
+  for (int i = 0; i < kErrorMetricCount; ++i) {
+    const auto m = static_cast<ErrorMetric>(i);
+    EXPECT_TRUE(view_offers_metric(ViewMode::Difference, m));
+    EXPECT_EQ(view_offers_metric(ViewMode::RelativeError, m), m != ErrorMetric::Signed);  // noise has no sign
+    EXPECT_FALSE(view_offers_metric(ViewMode::Image, m));
+  }
+}
+
+TEST(ErrorMetrics, EStepsThroughTheMetricsTheViewOffersOnAnAutomaticRange) {
+  MeasureSettings s;
+  s.view_mode = ViewMode::RelativeError;
+  EXPECT_FALSE(s.heat_map.range.automatic);  // the heat map starts on its fixed 0.001..10
+  std::vector<ErrorMetric> seen;
+  for (int i = 0; i < 4; ++i) {
+    s.step_metric(1);
+    seen.push_back(s.heat_map.metric);
+    EXPECT_TRUE(s.heat_map.range.automatic);
+  }
+  EXPECT_EQ(seen, (std::vector<ErrorMetric>{ErrorMetric::RelativeSquared, ErrorMetric::Absolute, ErrorMetric::Squared,
+                                            ErrorMetric::Relative}));  // never Signed
+  s.step_metric(-1);
+  EXPECT_EQ(s.heat_map.metric, ErrorMetric::Squared);
+  EXPECT_EQ(s.difference.metric, ErrorMetric::Signed);  // the other view's is its own
+  s.view_mode = ViewMode::Difference;
+  s.step_metric(-1);
+  EXPECT_EQ(s.difference.metric, ErrorMetric::RelativeSquared);
+  s.view_mode = ViewMode::Image;
+  s.step_metric(1);
+  EXPECT_EQ(s.difference.metric, ErrorMetric::RelativeSquared);
+}
+
+TEST(ErrorMetrics, HeatMapStandardErrorIsTheRelativeOneTimesMeanPlusEpsilon) {
+  PublishedImage img = flat_image(2, 1, 0.5f);
+  img.relative_standard_error = {0.1f, 0.0f};
+  const double se = 0.1 * (0.5 + kRelMseEpsilon);
+  EXPECT_NEAR(heat_map_values(img, ErrorMetric::Relative)[0], 0.1, 1e-7);
+  EXPECT_NEAR(heat_map_values(img, ErrorMetric::Absolute)[0], se, 1e-7);
+  EXPECT_NEAR(heat_map_values(img, ErrorMetric::Squared)[0], se * se, 1e-8);
+  EXPECT_NEAR(heat_map_values(img, ErrorMetric::RelativeSquared)[0], 0.01, 1e-8);
+  EXPECT_EQ(heat_map_values(img, ErrorMetric::Absolute)[1], 0.0f);
+}
+
+TEST(ViewRange, AutomaticRangeSpansThePercentilesRounded) {
+  // 0.003 to 0.3, evenly in log, and one firefly.
+  std::vector<float> v;
+  for (int i = 0; i < 1000; ++i) v.push_back(static_cast<float>(0.003 * std::pow(100.0, i / 999.0)));
+  v.push_back(1e6f);
+  v.push_back(0.0f);  // a noiseless pixel: no part of a log range
+  LayerOptions o;
+  o.metric = ErrorMetric::Absolute;
+  const ColourScale s = error_scale(ViewMode::Difference, o, v);
+  EXPECT_TRUE(s.logarithmic);
+  EXPECT_FALSE(s.diverging);
+  EXPECT_DOUBLE_EQ(s.lo, 0.002);  // below the 1st percentile, 0.00314
+  EXPECT_DOUBLE_EQ(s.hi, 0.5);    // above the 99th, 0.288; the firefly is not seen
+  EXPECT_DOUBLE_EQ(nice_floor(0.00314), 0.002);
+  EXPECT_DOUBLE_EQ(nice_floor(0.05), 0.05);
+  EXPECT_DOUBLE_EQ(nice_floor(9.9), 5.0);
+  // The signed error: symmetric, its half range from |d|'s 99th percentile.
+  o.metric = ErrorMetric::Signed;
+  const ColourScale d = error_scale(ViewMode::Difference, o, v);
+  EXPECT_TRUE(d.diverging);
+  EXPECT_DOUBLE_EQ(d.hi, 0.5);
+  EXPECT_DOUBLE_EQ(d.lo, -0.5);
+  // Nothing positive: a range still.
+  const ColourScale none = error_scale(ViewMode::RelativeError, default_difference_options(), {0.0f, NAN});
+  EXPECT_LT(none.lo, none.hi);
+}
+
+TEST(ViewRange, AFixedRangeIsKeptAndABadOneMadeUsable) {
+  LayerOptions o;
+  o.metric = ErrorMetric::Squared;
+  o.range = {false, 0.02, 0.5};
+  const ColourScale s = error_scale(ViewMode::Difference, o, {1e-9f, 100.0f});
+  EXPECT_DOUBLE_EQ(s.lo, 0.02);
+  EXPECT_DOUBLE_EQ(s.hi, 0.5);
+  EXPECT_EQ(s.colour(0.5), sequential_colour(1.0));
+  EXPECT_EQ(s.colour(0.02), sequential_colour(0.0));
+  EXPECT_EQ(s.colour(100.0), sequential_colour(1.0));  // beyond the range: clamped
+  EXPECT_NEAR(s.position(0.1), std::log10(5.0) / std::log10(25.0), 1e-12);
+  const ViewRange swapped = sanitized({false, 0.5, 0.02}, false);
+  EXPECT_DOUBLE_EQ(swapped.lo, 0.02);
+  EXPECT_DOUBLE_EQ(swapped.hi, 0.5);
+  for (const ViewRange& bad : {ViewRange{false, 0.0, 0.0}, ViewRange{false, -1.0, NAN}, ViewRange{false, 3.0, 3.0}}) {
+    const ViewRange r = sanitized(bad, false);
+    EXPECT_GT(r.lo, 0.0);
+    EXPECT_GT(r.hi, r.lo);
+    EXPECT_TRUE(std::isfinite(r.hi));
+  }
+  EXPECT_DOUBLE_EQ(sanitized({false, 0.0, -2.0}, true).hi, 1.0);
+  o.metric = ErrorMetric::Signed;
+  o.range = {false, -0.1, 0.1};
+  EXPECT_DOUBLE_EQ(error_scale(ViewMode::Difference, o, {5.0f}).hi, 0.1);
+}
+
+TEST(ColourMaps, LegendOfASetRangeLabelsBothEndsAndRoundValuesBetween) {
+  ColourScale s;
+  s.logarithmic = true;
+  s.lo = 0.02;
+  s.hi = 0.5;
+  const auto ticks = legend_ticks(s);
+  const char* labels[] = {"0.02", "0.05", "0.1", "0.2", "0.5"};
+  ASSERT_EQ(ticks.size(), 5u);
+  for (std::size_t i = 0; i < ticks.size(); ++i) {
+    EXPECT_EQ(ticks[i].label, labels[i]);
+    EXPECT_NEAR(ticks[i].position, s.position(std::stod(labels[i])), 1e-12);  // each tick where its value is
+  }
+  // Fifteen decades: the ends and a few decades between, in order, none crowding an end.
+  s.lo = 1e-9;
+  s.hi = 1e6;
+  const auto wide = legend_ticks(s);
+  ASSERT_GE(wide.size(), 4u);
+  EXPECT_LE(wide.size(), 7u);
+  EXPECT_EQ(wide.front().label, "1e-09");
+  EXPECT_EQ(wide.back().label, "1e+06");
+  for (std::size_t i = 1; i < wide.size(); ++i) {
+    EXPECT_GT(wide[i].position, wide[i - 1].position + 0.1) << wide[i].label;
+    EXPECT_NEAR(wide[i].position, s.position(std::stod(wide[i].label)), 1e-9);
+  }
+}
+
+TEST(ViewLayer, MetricAndRangeChangesRebuildTheLayerInTheirColours) {
+  MeasureState m;
+  ReferenceImage ref;
+  ref.width = 2;
+  ref.height = 1;
+  ref.rgb.assign(6, 0.5f);
+  m.set_reference(ref);
+  m.published = flat_image(2, 1, 0.625f);  // an error of 1/8, exactly
+  MeasureSettings s;
+  s.view_mode = ViewMode::Difference;
+  s.difference.metric = ErrorMetric::Squared;
+  s.difference.range = {false, 1.0 / 256.0, 1.0 / 16.0};
+  ASSERT_TRUE(m.refresh_layer(s));
+  EXPECT_FALSE(m.refresh_layer(s));  // nothing changed: nothing to upload
+  // (1/8)^2 sits half way between 1/256 and 1/16 on the log scale.
+  const Colour mid = sequential_colour(0.5);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(m.layer.rgba[c], static_cast<std::uint8_t>(std::lround(mid[c] * 255.0f)));
+  EXPECT_NE(m.layer.scale.title.find("^2"), std::string::npos);
+  s.difference.range.hi = 1.0 / 64.0;  // now at the top
+  ASSERT_TRUE(m.refresh_layer(s));
+  const Colour top = sequential_colour(1.0);
+  EXPECT_EQ(m.layer.rgba[0], static_cast<std::uint8_t>(std::lround(top[0] * 255.0f)));
+  s.difference.metric = ErrorMetric::Signed;
+  s.difference.range.automatic = true;
+  ASSERT_TRUE(m.refresh_layer(s));
+  EXPECT_TRUE(m.layer.scale.diverging);
+  EXPECT_DOUBLE_EQ(m.layer.scale.hi, 0.2);
+  // The heat map keeps its own options.
+  s.view_mode = ViewMode::RelativeError;
+  ASSERT_TRUE(m.refresh_layer(s));
+  EXPECT_DOUBLE_EQ(m.layer.scale.lo, 1e-3);
+  EXPECT_DOUBLE_EQ(m.layer.scale.hi, 10.0);
+}
+
 TEST(Reference, FiguresAreCorrectedForTheReferencesNoise) {
   ReferenceImage ref;
   ref.width = 4;
