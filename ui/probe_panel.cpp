@@ -151,17 +151,18 @@ void chi_square_section(ProbeState& s, double now) {
     return;
   }
   if (!s.chi) {
-    ImGui::TextColored(kDim, "%d samples vs the pdf integrated per cell", kChiSamples);
+    ImGui::TextColored(kDim, "%d samples from each sampler vs the pdf integrated per cell", kChiSamples);
     return;
   }
   const ProbeChiSquare& c = *s.chi;
   ImGui::TextColored(c.passed ? kGreen : kRed, "%s", c.passed ? "PASS" : "FAIL");
   ImGui::SameLine();
-  ImGui::Text("p = %.3g  (alpha %.2g)   chi2 %.1f, dof %d   %.2f s", c.result.p_value, c.alpha, c.result.statistic,
-              c.result.dof, s.chi_seconds);
-  if (c.result.zero_cell_hits > 0)
-    ImGui::TextColored(kRed, "%llu samples where the pdf is zero",
-                       static_cast<unsigned long long>(c.result.zero_cell_hits));
+  ImGui::Text("packet p = %.3g, one-path p = %.3g  (alpha %.2g)   %.2f s", c.result.p_value,
+              c.one_path_result.p_value, c.alpha, s.chi_seconds);
+  ImGui::TextColored(kDim, "packet sampler (what renders): chi2 %.1f, dof %d", c.result.statistic, c.result.dof);
+  const std::uint64_t zero_hits = c.result.zero_cell_hits + c.one_path_result.zero_cell_hits;
+  if (zero_hits > 0)
+    ImGui::TextColored(kRed, "%llu samples where the pdf is zero", static_cast<unsigned long long>(zero_hits));
   const BandHistogram bands = cos_theta_bands(c);
   const int n = static_cast<int>(bands.observed.size());
   std::vector<double> all = bands.observed;

@@ -1,5 +1,7 @@
 #include "renderer/metrics/probe.h"
 
+#include "renderer/metrics/chi_square.h"
+
 #include "renderer/sampling/onb.h"
 
 #include <algorithm>
@@ -134,72 +136,17 @@ ProbeChiSquare probe_chi_square(const SamplingPlan& plan, const ProbePoint& at, 
   out.observed.assign(cells, 0);
   out.expected.assign(cells, 0.0);
   if (!at.found || plan.nee_mis) return out;  // nee-mis draws two directions; see probe_directions
-
-  auto cell_of = [&](const Vec3& d) {
-    float u, v;
-    direction_to_map(at, d, u, v);
-    const int col = std::min(phi_cells - 1, static_cast<int>(u * static_cast<float>(phi_cells)));
-    const int row = std::min(z_cells - 1, static_cast<int>(v * static_cast<float>(z_cells)));
-    return static_cast<std::size_t>(row) * phi_cells + col;
-  };
-  Rng rng(seed, 5);
-  for (int i = 0; i < samples; ++i) {
-    const DirectionSample ds = plan.sample(at.point, at.normal, rng);
-    if (ds.none) {
-      ++out.empty_samples;
-      continue;
-    }
-    ++out.observed[cell_of(ds.direction)];
-  }
-  // Expected: N times the pdf integrated over each cell (cells have equal
-  // solid angle 4 pi / cells). Midpoint rule on 8 x 8 points; a cell where the
-  // pdf is not constant across them (a target's outline crosses it) is
-  // integrated again on 64 x 64, so edges do not fake a failure. The empty
-  // samples are the technique's missing mass, so N counts all samples.
-  const MapFrame f(at.normal);
-  const double cell_solid_angle = 4.0 * std::numbers::pi / static_cast<double>(cells);
-  auto integrate = [&](int row, int col, int sub, float& lo, float& hi) {
-    double sum = 0.0;
-    lo = kInf, hi = -kInf;
-    for (int a = 0; a < sub; ++a)
-      for (int b = 0; b < sub; ++b) {
-        const float v = (static_cast<float>(row) + (static_cast<float>(a) + 0.5f) / static_cast<float>(sub)) /
-                        static_cast<float>(z_cells);
-        const float u = (static_cast<float>(col) + (static_cast<float>(b) + 0.5f) / static_cast<float>(sub)) /
-                        static_cast<float>(phi_cells);
-        const float p = plan.pdf(at.point, at.normal, f.direction(1.0f - 2.0f * v, 2.0f * kPi * u));
-        lo = min_of(lo, p), hi = max_of(hi, p);
-        sum += p;
-      }
-    return sum / (static_cast<double>(sub) * sub);
-  };
-  // Cells an outline crosses, and their neighbours (a sliver of a target can
-  // miss all 64 points of a cell next to one), get the fine grid.
-  std::vector<char> edge(cells, 0);
-  for (int row = 0; row < z_cells; ++row)
-    for (int col = 0; col < phi_cells; ++col) {
-      float lo, hi;
-      const std::size_t i = static_cast<std::size_t>(row) * phi_cells + col;
-      out.expected[i] = integrate(row, col, 8, lo, hi);
-      edge[i] = hi > lo * 1.5f + 1e-6f;
-    }
-  for (int row = 0; row < z_cells; ++row)
-    for (int col = 0; col < phi_cells; ++col) {
-      bool near_edge = false;
-      for (int dr = -1; dr <= 1; ++dr)
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int r = row + dr, c = (col + dc + phi_cells) % phi_cells;  // azimuth wraps
-          if (r >= 0 && r < z_cells && edge[static_cast<std::size_t>(r) * phi_cells + c]) near_edge = true;
-        }
-      const std::size_t i = static_cast<std::size_t>(row) * phi_cells + col;
-      float lo, hi;
-      // Still no density where samples landed: look much closer.
-      const int sub = out.expected[i] == 0.0 && out.observed[i] > 0 ? 256 : (near_edge ? 64 : 0);
-      if (sub) out.expected[i] = integrate(row, col, sub, lo, hi);
-      out.expected[i] *= static_cast<double>(samples) * cell_solid_angle;
-    }
-  out.result = stats::chi_square_test(out.observed, out.expected);
-  out.passed = out.result.zero_cell_hits == 0 && out.result.p_value > alpha;
+  const chi_square::Grid grid{z_cells, phi_cells};
+  std::vector<chi_square::Outcome> both = chi_square::check_plan(
+      plan, at.point, at.normal, {chi_square::Sampler::Packet, chi_square::Sampler::OnePath}, samples, seed, grid);
+  chi_square::Outcome& packet = both[0];
+  const chi_square::Outcome& one_path = both[1];
+  out.result = packet.chi;
+  out.one_path_result = one_path.chi;
+  out.observed = std::move(packet.observed);
+  out.expected = std::move(packet.expected);
+  out.empty_samples = packet.empty_samples;
+  out.passed = packet.passed(alpha) && one_path.passed(alpha);
   return out;
 }
 

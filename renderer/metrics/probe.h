@@ -39,11 +39,15 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
 // Map coordinates (0..1) of a direction in pdf_map's layout.
 void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);
 
-// Chi-square test of plan.sample against plan.pdf at the probe point: samples
-// binned in `phi_cells` x `z_cells` equal-solid-angle cells over the sphere,
-// expected counts from the pdf integrated over each cell by supersampling.
+// Chi-square test of the plan's samplers against plan.pdf at the probe point,
+// by the test suite's harness (chi_square.h): samples binned in `phi_cells` x
+// `z_cells` equal-solid-angle cells over the sphere, expected counts from the
+// pdf integrated over each cell along the targets' outlines. It runs the packet
+// kernel's sampler (what renders; its counts are the ones kept) and the
+// one-path tracer's; it passes when both do.
 struct ProbeChiSquare {
-  stats::ChiSquareResult result;
+  stats::ChiSquareResult result;           // the packet sampler's
+  stats::ChiSquareResult one_path_result;  // the one-path sampler's
   bool passed = false;
   double alpha = 0.01;
   int z_cells = 0, phi_cells = 0;
