@@ -53,6 +53,20 @@ void add_cache_dir_option(CLI::App* command, std::string& cache_dir) {
                       "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, else $XDG_CACHE_HOME/pdflab/references)");
 }
 
+// A headless comparison's reference (bench, sweep): the file or the cache, and
+// the size to look it up at.
+void add_comparison_reference_options(CLI::App* command, std::string& reference, int& width, int& height,
+                                      std::string& cache_dir) {
+  command->add_option("--reference", reference,
+                      "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
+      ->required();
+  command->add_option("--width", width, "With --reference auto: image width (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  command->add_option("--height", height, "With --reference auto: image height (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  add_cache_dir_option(command, cache_dir);
+}
+
 CLI::Validator non_negative_integer() {
   return CLI::Validator(
       [](std::string& value) {
@@ -168,14 +182,7 @@ int main(int argc, char** argv) {
   bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")
       ->check(positive_number(" of seconds"));
   bench->add_option("--spp", bo.spp, "Samples per pixel per strategy (equal samples)")->check(CLI::Range(1u, 1u << 30));
-  bench->add_option("--reference", bo.reference,
-                    "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
-      ->required();
-  bench->add_option("--width", bo.width, "With --reference auto: image width (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  bench->add_option("--height", bo.height, "With --reference auto: image height (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  add_cache_dir_option(bench, bo.cache_dir);
+  add_comparison_reference_options(bench, bo.reference, bo.width, bo.height, bo.cache_dir);
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
   bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
@@ -193,14 +200,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--strategy", so.strategy, "Base mixture: the other techniques keep their weights");
   sweep->add_option("--seconds", so.seconds, "Render time per run (equal time)")->check(positive_number(" of seconds"));
   sweep->add_option("--spp", so.spp, "Samples per pixel per run (equal samples)")->check(CLI::Range(1u, 1u << 30));
-  sweep->add_option("--reference", so.reference,
-                    "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
-      ->required();
-  sweep->add_option("--width", so.width, "With --reference auto: image width (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  sweep->add_option("--height", so.height, "With --reference auto: image height (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  add_cache_dir_option(sweep, so.cache_dir);
+  add_comparison_reference_options(sweep, so.reference, so.width, so.height, so.cache_dir);
   sweep->add_option("--seeds", so.seeds, "Runs per weight, for the intervals (default 3)")->check(CLI::Range(1, 1000));
   sweep->add_option("--seed", so.seed, "First seed (default 2; use one the reference was not rendered with)")
       ->check(non_negative_integer());

@@ -1,6 +1,7 @@
 #include "ui/screenshot.h"
 
 #include "renderer/error.h"
+#include "renderer/metrics/reference.h"
 
 #include <nlohmann/json.hpp>
 
@@ -37,9 +38,8 @@ void remove_quietly(const std::string& path) {
 
 std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& paths) {
   nlohmann::json j;
-  j["scene"] = d.scene_name;
-  j["scene_file"] = d.scene_file;
-  j["strategy"] = d.strategy.to_string();
+  put_render_facts(j, {d.scene_name, d.scene_file, d.strategy.to_string(), d.width, d.height, d.max_depth, d.seed,
+                      d.spp, d.seconds, d.version});
   j["unbiased"] = d.strategy.is_unbiased();
   double total = 0.0;
   for (float w : d.strategy.weights) total += w;
@@ -48,12 +48,6 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
     if (d.strategy.weights[i] > 0.0f)
       weights[std::string(technique_name(static_cast<Technique>(i)))] = d.strategy.weights[i] / total;
   j["weights"] = weights;
-  j["width"] = d.width;
-  j["height"] = d.height;
-  j["spp"] = d.spp;
-  j["seconds"] = d.seconds;
-  j["seed"] = d.seed;
-  j["max_depth"] = d.max_depth;
   const auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
   j["camera"] = {{"lookfrom", vec(d.camera.lookfrom)},
                  {"lookat", vec(d.camera.lookat)},
@@ -64,7 +58,6 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
   j["transfer"] = d.transfer == Transfer::Gamma2 ? "gamma2" : "srgb";
   j["png"] = fs::path(paths.png).filename().string();
   j["pfm"] = fs::path(paths.pfm).filename().string();
-  j["version"] = d.version;
   return j.dump(2) + "\n";
 }
 

@@ -126,6 +126,19 @@ Reference reference_from_film(const Film& film, ReferenceInfo info) {
   return r;
 }
 
+void put_render_facts(json& j, const RenderFacts& f) {
+  j["scene"] = f.scene_name;
+  j["scene_file"] = f.scene_file;
+  j["strategy"] = f.strategy;
+  j["width"] = f.width;
+  j["height"] = f.height;
+  j["max_depth"] = f.max_depth;
+  j["seed"] = f.seed;
+  j["spp"] = f.spp;
+  j["seconds"] = f.seconds;
+  j["version"] = f.version;
+}
+
 void save_reference(const std::string& mean_path, const Reference& ref) {
   const ReferencePaths paths = reference_paths(mean_path);
   check_output_path(paths.mean);
@@ -136,19 +149,11 @@ void save_reference(const std::string& mean_path, const Reference& ref) {
   json j;
   j["format"] = kFormat;
   j["format_version"] = kFormatVersion;
-  j["scene"] = i.scene_name;
-  j["scene_file"] = i.scene_file;
+  put_render_facts(j, {i.scene_name, i.scene_file, i.strategy, ref.width, ref.height, i.max_depth, i.seed, i.spp,
+                      i.seconds, i.version});
   j["scene_hash"] = i.scene_hash;
-  j["width"] = ref.width;
-  j["height"] = ref.height;
-  j["max_depth"] = i.max_depth;
-  j["strategy"] = i.strategy;
-  j["seed"] = i.seed;
   j["seed_stream"] = i.seed_stream;
-  j["spp"] = i.spp;
-  j["seconds"] = i.seconds;
   j["estimated_relmse"] = i.estimated_relmse;
-  j["version"] = i.version;
   j["mean_file"] = fs::path(paths.mean).filename().string();
   j["variance_file"] = fs::path(paths.variance).filename().string();
   j["mean_checksum"] = fnv1a_hex(mean.data(), mean.size());

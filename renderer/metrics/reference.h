@@ -11,6 +11,8 @@
 // `render`/`bench --reference auto` and the viewer look.
 #include "renderer/sampling/strategy.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -43,6 +45,18 @@ struct ReferenceInfo {
   double estimated_relmse = 0.0;  // the reference's own noise, as relMSE
   std::string version;
 };
+
+// The facts of a render that every sidecar carries (a reference's, a
+// screenshot's), which load_reference reads back: written by one function.
+struct RenderFacts {
+  std::string scene_name, scene_file, strategy;
+  int width = 0, height = 0, max_depth = 0;
+  std::uint64_t seed = 0;
+  std::uint32_t spp = 0;
+  double seconds = 0.0;
+  std::string version;
+};
+void put_render_facts(nlohmann::json& sidecar, const RenderFacts& facts);
 
 struct Reference {
   std::string path;         // of the mean image
