@@ -36,12 +36,12 @@ struct Result {
   std::vector<Checkpoint> curve;
 };
 
-std::vector<Strategy> parse_strategy_list(const std::string& text) {
+std::vector<Strategy> parse_strategy_list(const std::string& text, int roulette_depth) {
   std::vector<Strategy> out;
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ';'))
-    if (item.find_first_not_of(" \t") != std::string::npos) out.push_back(Strategy::parse(item));
+    if (item.find_first_not_of(" \t") != std::string::npos) out.push_back(with_roulette(Strategy::parse(item), roulette_depth));
   if (out.empty()) throw InputError("--strategies lists no strategy (separate them with ';')");
   return out;
 }
@@ -145,7 +145,7 @@ int run_bench(const BenchOptions& o) {
   if (!o.curves.empty()) check_output_path(o.curves);
   check_distinct_outputs({o.csv, o.plot, o.curves});
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
-  const std::vector<Strategy> strategies = parse_strategy_list(o.strategies);
+  const std::vector<Strategy> strategies = parse_strategy_list(o.strategies, o.roulette_depth);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
   const Reference reference = comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height},
                                                    strategies, {o.seed}, o.quiet);
@@ -170,16 +170,17 @@ int run_bench(const BenchOptions& o) {
   // est_relmse: what the film predicts without a reference; unbiased: 0 for a
   // strategy whose pdf misses directions the integrand needs.
   // relmse is corrected for the reference's own noise, relmse_raw is not;
-  // relmse_ci: 95% half width of relmse; ref_share: the reference's part of relmse_raw.
+  // relmse_ci: 95% half width of relmse; ref_share: the reference's part of relmse_raw;
+  // roulette_depth: where Russian roulette starts (0: off).
   std::string csv =
       "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased,relmse_raw,"
-      "relmse_ci,ref_share\n";
+      "relmse_ci,ref_share,roulette_depth\n";
   char line[512];
   for (const Result& r : results) {
-    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g\n", r.spp, r.seconds,
+    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g,%d\n", r.spp, r.seconds,
                   r.rmse, r.error.corrected, r.efficiency, r.samples_per_second,
                   static_cast<unsigned long long>(r.dropped), r.estimated_relmse, r.strategy.is_unbiased() ? 1 : 0,
-                  r.error.raw, r.error.interval, r.error.reference_share());
+                  r.error.raw, r.error.interval, r.error.reference_share(), r.strategy.roulette_depth);
     csv += csv_field(r.strategy.to_string()) + line;
   }
 

@@ -12,6 +12,7 @@ namespace pdflab {
 struct BenchOptions {
   std::string scene;
   std::string strategies;  // "S1;S2;..."
+  int roulette_depth = 0;  // --rr: Russian roulette from this depth on in every strategy (0: as given)
   double seconds = 0.0;    // equal time per strategy (or)
   std::uint32_t spp = 0;   // equal samples per pixel
   std::string reference;   // PFM (its size sets the render size) or "auto" (the cache)

@@ -80,6 +80,15 @@ CLI::Validator non_negative_integer() {
       "UINT64");
 }
 
+// --rr or --rr=D: Russian roulette in every strategy the command renders.
+void add_roulette_option(CLI::App* command, int& depth) {
+  command
+      ->add_flag("--rr{" + std::to_string(pdflab::kDefaultRouletteDepth) + "}", depth,
+                 "Russian roulette in every strategy, from path depth D on (--rr=D; default " +
+                     std::to_string(pdflab::kDefaultRouletteDepth) + "): the same as +rr:D on each")
+      ->check(CLI::Range(1, pdflab::kMaxRouletteDepth));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -141,6 +150,7 @@ int main(int argc, char** argv) {
                      "Reference to measure against: a .pfm, or 'auto' for the cached one of this scene, size and depth");
   add_cache_dir_option(render, ro.cache_dir);
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
+  add_roulette_option(render, ro.roulette_depth);
 
   pdflab::ReferenceOptions fo;
   CLI::App* reference = app.add_subcommand(
@@ -163,6 +173,7 @@ int main(int argc, char** argv) {
   add_cache_dir_option(reference, fo.cache_dir);
   reference->add_option("--threads", fo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   reference->add_flag("--quiet", fo.quiet, "No progress bar or notes");
+  add_roulette_option(reference, fo.roulette_depth);
 
   pdflab::MergeOptions mo;
   CLI::App* merge = app.add_subcommand("merge", "Add films of one scene and settings with disjoint sample ranges");
@@ -190,6 +201,7 @@ int main(int argc, char** argv) {
       ->check(non_negative_integer());
   bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   bench->add_flag("--quiet", bo.quiet, "No progress line");
+  add_roulette_option(bench, bo.roulette_depth);
 
   pdflab::SweepOptions so;
   CLI::App* sweep =
@@ -209,6 +221,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--map", so.map, "Each pixel's predicted best weight, blue (0) to red (1) (PNG)");
   sweep->add_option("--threads", so.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
   sweep->add_flag("--quiet", so.quiet, "No progress");
+  add_roulette_option(sweep, so.roulette_depth);
   sweep->add_flag("--auto", so.auto_weight,
                   "Also render with auto weight (chosen between passes from the prediction) and compare");
 

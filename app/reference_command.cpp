@@ -53,7 +53,8 @@ int run_reference(const ReferenceOptions& o) {
   if (o.max_depth != 0) scene->max_depth = o.max_depth;
   check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
   scene->prepare();
-  const Strategy strategy = o.strategy.empty() ? default_reference_strategy(*scene) : Strategy::parse(o.strategy);
+  const Strategy strategy = with_roulette(
+      o.strategy.empty() ? default_reference_strategy(*scene) : Strategy::parse(o.strategy), o.roulette_depth);
   const std::string cache_dir = reference_cache_dir(o.cache_dir);
   const ReferenceKey key = reference_key(*scene);
   const CacheLookup before = find_cached_reference(cache_dir, key);

@@ -127,9 +127,10 @@ Resumed open_resume(const RenderOptions& o) {
   const SampleRange& range = info.ranges.front();
   if (!o.scene_given) r.scene = info.scene_file;
   if (!o.strategy_given) r.strategy = info.strategy;
-  else if (Strategy::parse(r.strategy).to_string() != info.strategy)
+  if ((o.strategy_given || o.roulette_depth > 0) &&
+      with_roulette(Strategy::parse(r.strategy), o.roulette_depth).to_string() != info.strategy)
     throw InputError("--resume: " + film + " was rendered with strategy '" + info.strategy + "', not '" +
-                     Strategy::parse(r.strategy).to_string() + "'");
+                     with_roulette(Strategy::parse(r.strategy), o.roulette_depth).to_string() + "'");
   if (o.seed_given && o.seed != range.seed)
     throw InputError("--resume: " + film + " was rendered with seed " + std::to_string(range.seed) + ", not " +
                      std::to_string(o.seed));
@@ -177,7 +178,7 @@ int run_render(const RenderOptions& o) {
   if (height != 0) scene->camera.height = height;
   if (width != 0 || height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
   scene->prepare();
-  const Strategy strategy = Strategy::parse(strategy_text);
+  const Strategy strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
   (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
 
   FilmInfo info;
@@ -321,6 +322,8 @@ int run_render(const RenderOptions& o) {
     j["scene_file"] = scene_path;
     j["strategy"] = strategy.to_string();
     j["unbiased"] = strategy.is_unbiased();
+    j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
+    if (strategy.fastest) j["expanded_from"] = "fastest";
     j["width"] = final_info.width;
     j["height"] = final_info.height;
     j["spp"] = final_info.spp();

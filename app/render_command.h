@@ -12,6 +12,7 @@ struct RenderOptions {
   bool scene_given = true;
   std::string strategy;
   bool strategy_given = true;
+  int roulette_depth = 0;  // --rr: Russian roulette from this depth on in every strategy (0: as given)
   std::uint32_t spp = 0;
   bool spp_given = true;
   std::string out;

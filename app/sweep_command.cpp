@@ -88,6 +88,7 @@ struct Family {
   std::string a, b;
   double share = 1.0;                                 // the pair's total weight
   std::vector<std::pair<std::string, double>> rest;  // the others, normalised weights
+  int roulette_depth = 0;                             // Strategy::roulette_depth of every run
 
   Strategy at(double w) const {
     char buf[64];
@@ -98,7 +99,7 @@ struct Family {
       std::snprintf(buf, sizeof buf, ",%s=%.9g", name.c_str(), weight);
       text += buf;
     }
-    return Strategy::parse(text);
+    return with_roulette(Strategy::parse(text), roulette_depth);
   }
   MixtureFamily mixture_family() const {
     MixtureFamily m;
@@ -114,11 +115,12 @@ struct Family {
   }
 };
 
-Family parse_family(const std::string& vary, const std::string& base) {
+Family parse_family(const std::string& vary, const std::string& base, int roulette_depth) {
   const std::size_t comma = vary.find(',');
   if (comma == std::string::npos || vary.find(',', comma + 1) != std::string::npos)
     throw InputError("--vary '" + vary + "' is not two techniques A,B (for example cosine,light)");
   Family f;
+  f.roulette_depth = roulette_depth;
   for (std::string* name : {&f.a, &f.b}) {
     *name = trim(name == &f.a ? vary.substr(0, comma) : vary.substr(comma + 1));
     Strategy s;
@@ -133,7 +135,9 @@ Family parse_family(const std::string& vary, const std::string& base) {
   }
   if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
   if (base.empty()) return f;
-  const Strategy s = Strategy::parse(base);
+  Strategy s = Strategy::parse(base);
+  if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
+  s.roulette_depth = 0;  // the mixture's terms alone
   if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
   double pair = 0.0;
   for (const auto& [name, weight] : mixture_terms(s))
@@ -348,7 +352,7 @@ int run_sweep(const SweepOptions& o) {
   if (!o.map.empty()) check_output_path(o.map);
   check_distinct_outputs({o.csv, o.plot, o.map});
   const std::vector<double> weights = parse_weights(o.weights);
-  const Family family = parse_family(o.vary, o.strategy);
+  const Family family = parse_family(o.vary, o.strategy, o.roulette_depth);
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   // Every strategy of the sweep is checked against the scene before the first render.
   std::vector<Row> rows;

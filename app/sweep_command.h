@@ -9,6 +9,7 @@ struct SweepOptions {
   std::string vary;       // "A,B": the two techniques whose shares are swept
   std::string weights;    // "LO:HI:STEP": A's share of the pair
   std::string strategy;   // optional base mixture: the other techniques' weights and the pair's total
+  int roulette_depth = 0;  // --rr: Russian roulette from this depth on in every strategy (0: as given)
   double seconds = 0.0;   // equal time per run (or)
   std::uint32_t spp = 0;  // equal samples per pixel
   std::string reference;  // PFM (its size sets the render size) or "auto" (the cache)

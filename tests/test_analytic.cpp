@@ -267,8 +267,14 @@ TEST_P(Analytic, MatchesTheClosedFormWithinThreeStandardErrors) {
 
 std::vector<Param> cases() {
   std::vector<Param> out;
+  // Russian roulette trades samples' cost for their variance: more of them
+  // reach the precision the comparison needs.
+  const auto light_spp = [](const std::string& s) { return s.find("+rr") != std::string::npos ? 256u : 64u; };
   const std::vector<std::string> light_strategies = {"light",        "light-sa", "mix:cosine=0.5,light=0.5",
-                                                     "mix:cosine=0.5,light-sa=0.5", "nee-mis", "nee-mis:balance"};
+                                                     "mix:cosine=0.5,light-sa=0.5", "nee-mis", "nee-mis:balance",
+                                                     // continuations drawn by a mixture, Russian roulette
+                                                     "nee-mis+mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light=0.5+rr:1",
+                                                     "nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr:1"};
   const std::vector<std::string> blind_strategies = {"cosine", "uniform-hemisphere",
                                                      "mix:uniform-sphere=0.5,light=0.5"};
   for (const double scale : {1e-3, 1.0, 1e3, 1e6}) {
@@ -284,7 +290,7 @@ std::vector<Param> cases() {
         c.light_size = size;
         c.light_z = 0.3;
         c.name = std::string(sc) + (shape == LightShape::Quad ? "_quad" : "_sphere") + sz;
-        for (const auto& s : light_strategies) out.push_back({c, s, 64});
+        for (const auto& s : light_strategies) out.push_back({c, s, light_spp(s)});
         // Strategies blind to the light find it only when it is large.
         if (size >= 1e-1 && shape == LightShape::Quad)
           for (const auto& s : blind_strategies)
@@ -298,7 +304,7 @@ std::vector<Param> cases() {
       g.light_height = 1e-3;
       g.light_z = -0.9;
       g.name = std::string(sc) + "_grazing" + sz;
-      for (const auto& s : light_strategies) out.push_back({g, s, 64});
+      for (const auto& s : light_strategies) out.push_back({g, s, light_spp(s)});
     }
   }
   // Slivers: a strip 1e-1 of the scene long and 1e-8 of it wide subtends less
@@ -313,7 +319,7 @@ std::vector<Param> cases() {
     char sc[16];
     std::snprintf(sc, sizeof sc, "s%g", scale);
     c.name = std::string(sc) + "_sliver";
-    for (const auto& s : light_strategies) out.push_back({c, s, 64});
+    for (const auto& s : light_strategies) out.push_back({c, s, light_spp(s)});
   }
   // Big ground spheres (the first book's ground sphere has radius 1000).
   for (const double radius : {1e3, 1e5}) {
@@ -323,7 +329,7 @@ std::vector<Param> cases() {
     c.light_size = 0.1;
     c.light_z = 0.3;
     c.name = radius == 1e3 ? "ground_sphere_1e3" : "ground_sphere_1e5";
-    for (const auto& s : light_strategies) out.push_back({c, s, 64});
+    for (const auto& s : light_strategies) out.push_back({c, s, light_spp(s)});
   }
   // Every case again through the one-path tracer.
   const std::size_t n = out.size();

@@ -64,6 +64,13 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"mix:cosine=0.5,light-sa=0.5", 512},
       {"nee-mis", 256},
       {"nee-mis:balance", 256},
+      // Russian roulette, and nee-mis continued by a mixture that keeps aiming at the glass sphere.
+      {"mix:cosine=0.5,light=0.5+rr", 512},
+      {"cosine+rr:1", 1024},
+      {"nee-mis+rr", 256},
+      {"nee-mis+mix:cosine=0.5,light=0.5", 256},
+      {"nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr", 256},
+      {"fastest", 256},
   };
   return s;
 }
@@ -203,7 +210,10 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
                       {"mix:cosine=0.5,light=0.5", 256, false},
                       {"mix:cosine=0.5,light-sa=0.5", 256, false},
                       {"nee-mis", 128, false},
-                      {"nee-mis:balance", 128, false}};
+                      {"nee-mis:balance", 128, false},
+                      {"mix:cosine=0.5,light-sa=0.5+rr", 256, false},
+                      {"nee-mis+mix:cosine=0.5,light=0.5", 128, false},
+                      {"fastest", 128, false}};
   constexpr int kSmall = 24;
   const int tests = static_cast<int>(std::size(scenes) * std::size(runs)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
   const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));

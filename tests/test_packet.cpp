@@ -26,7 +26,14 @@ const char* const kStrategies[] = {"cosine",
                                    "mix:light=1,light-sa=1",
                                    "nee-mis",
                                    "nee-mis:balance",
-                                   "mix:cosine=1,uniform-hemisphere=1,uniform-sphere=1,light=2,light-sa=1"};
+                                   "mix:cosine=1,uniform-hemisphere=1,uniform-sphere=1,light=2,light-sa=1",
+                                   "mix:cosine=0.5,light=0.5+rr",
+                                   "cosine+rr:1",
+                                   "nee-mis+rr",
+                                   "nee-mis+mix:cosine=0.5,light=0.5",
+                                   "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2",
+                                   "nee-mis+mix:uniform-sphere=0.5,light=0.5",
+                                   "fastest"};
 
 Scene small_scene(const std::string& file, int width, int height) {
   Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);

@@ -133,6 +133,21 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
     if (flow_button(label, p == 1)) s = preset_sampling(static_cast<Preset>(p));
   }
   if (flow_button("4: nee-mis", false)) s = SamplingSettings::from(Strategy::nee());
+  if (flow_button("fastest", false)) s = fastest_sampling();
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("pdflab's most efficient unbiased strategy for general scenes: %s", kFastestStrategy.data());
+
+  // Russian roulette, for any strategy.
+  bool roulette = s.roulette_depth > 0;
+  if (ImGui::Checkbox("Russian roulette", &roulette)) s.roulette_depth = roulette ? kDefaultRouletteDepth : 0;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("From depth D on, a path goes on with probability min(1, throughput x albedo) and is\n"
+                      "divided by it: unbiased, shorter paths; off is the book's estimator");
+  if (roulette) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+    ImGui::SliderInt("from depth", &s.roulette_depth, 1, 20, "%d", ImGuiSliderFlags_AlwaysClamp);
+  }
 
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;

@@ -41,6 +41,8 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
   put_render_facts(j, {d.scene_name, d.scene_file, d.strategy.to_string(), d.width, d.height, d.max_depth, d.seed,
                       d.spp, d.seconds, d.version});
   j["unbiased"] = d.strategy.is_unbiased();
+  j["russian_roulette_depth"] = d.strategy.roulette_depth;  // 0: off
+  if (d.strategy.fastest) j["expanded_from"] = "fastest";
   double total = 0.0;
   for (float w : d.strategy.weights) total += w;
   nlohmann::json weights = nlohmann::json::object();

@@ -5,19 +5,39 @@
 namespace pdflab::ui {
 
 Strategy SamplingSettings::strategy() const {
-  if (nee_mis) return Strategy::nee(heuristic);
   Strategy s = mixture ? Strategy{} : Strategy::single(single);
   if (mixture) s.weights = weights;
+  if (nee_mis) {
+    s = Strategy::nee(heuristic);
+    s.weights = continuation;
+  }
   s.parameters = parameters;
+  s.roulette_depth = roulette_depth;
+  s.fastest = fastest && s == fastest_sampling().strategy_without_name();
+  return s;
+}
+
+Strategy SamplingSettings::strategy_without_name() const {
+  SamplingSettings plain = *this;
+  plain.fastest = false;
+  return plain.strategy();
+}
+
+SamplingSettings fastest_sampling() {
+  SamplingSettings s = SamplingSettings::from(Strategy::parse("fastest"));
+  s.fastest = true;
   return s;
 }
 
 SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   SamplingSettings out;
   out.parameters = strategy.parameters;
+  out.roulette_depth = strategy.roulette_depth;
+  out.fastest = strategy.fastest;
   if (strategy.nee_mis) {
     out.nee_mis = true;
     out.heuristic = strategy.heuristic;
+    out.continuation = strategy.weights;
     // What the mixture sliders show if the user leaves nee-mis: the book's 50/50.
     out.weights[static_cast<int>(Technique::Cosine)] = 0.5f;
     out.weights[static_cast<int>(Technique::Light)] = 0.5f;

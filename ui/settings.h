@@ -25,8 +25,14 @@ struct SamplingSettings {
   // mixture (two samples per vertex); overrides the two above while set.
   bool nee_mis = false;
   MisHeuristic heuristic = MisHeuristic::Power;
+  // nee-mis's continuation (Strategy::weights; cosine alone unless a strategy
+  // such as `fastest` set another).
+  std::array<float, kTechniqueCount> continuation = Strategy::nee().weights;
+  int roulette_depth = 0;  // Strategy::roulette_depth, for any of the above
+  bool fastest = false;    // the `fastest` preset, as it expands
 
   Strategy strategy() const;
+  Strategy strategy_without_name() const;  // as strategy(), never marked `fastest`
   static SamplingSettings from(const Strategy& strategy);
   // Weights as the renderer will use them (sum 1), or all zero when they sum to 0.
   std::array<float, kTechniqueCount> normalised() const;
@@ -35,6 +41,8 @@ struct SamplingSettings {
 
 enum class Preset { CosineOnly = 1, LightOnly = 2, Book5050 = 3 };
 inline constexpr int kPresetCount = 3;
+// `fastest` (kFastestStrategy), as the panel edits it.
+SamplingSettings fastest_sampling();
 const char* preset_label(Preset p);
 SamplingSettings preset_sampling(Preset p);
 

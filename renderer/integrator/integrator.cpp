@@ -35,20 +35,34 @@ bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, boo
   return true;
 }
 
+// Russian roulette at a diffuse vertex reached by segment `depth`, before the
+// continuation (segment depth + 1) is drawn (leaf::russian_roulette): whether
+// the path goes on. Draws its random number only where it applies.
+bool roulette_survives(const SamplingPlan& plan, int depth, Vec3& throughput, const Vec3& albedo, Rng& rng) {
+  if (plan.roulette_depth <= 0 || depth + 1 < plan.roulette_depth) return true;
+  return leaf::russian_roulette(throughput, albedo, rng.uniform());
+}
+
 // Next-event estimation with MIS: at each diffuse vertex one light sample
 // (shadow ray, solid-angle sampling of the emitters chosen by power) and one
-// cosine sample. Emission reached by the cosine sample is weighted against the
-// light technique's density for the same direction, and vice versa, so each
-// light path is counted once in total.
+// sample of the plan's mixture (cosine alone for plain nee-mis) that continues
+// the path. Emission reached by the continuation is weighted against the light
+// technique's density for the same direction, and the light sample against the
+// mixture's, so each light path is counted once in total.
 Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
   Vec3 radiance(0.0f);
   Vec3 throughput(1.0f);
   bool unweighted_emission = true;  // camera rays and specular bounces: no light sample competes
-  float previous_pdf = 0.0f;        // the cosine sample's pdf at the last diffuse vertex
+  float previous_pdf = 0.0f;        // the continuation's pdf at the last diffuse vertex
   Vec3 previous_point(0.0f);
+  int aimed_quad = -1;  // the quad the continuation was aimed at (DirectionSample::aimed_quad)
+  float aimed_distance = 0.0f;
   for (int depth = 0; depth < scene.max_depth; ++depth) {
     Hit hit;
-    if (!intersect(scene, ray, kInf, hit)) {
+    const bool found = intersect_aimed(scene, ray, aimed_quad, aimed_distance, hit);
+    const int reached_quad = aimed_quad;  // the emitters' pdf below holds for a sliver aimed at
+    aimed_quad = -1;
+    if (!found) {
       radiance += throughput * scene.background;  // the background is not a light target
       break;
     }
@@ -60,7 +74,8 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       if (front_face || m.two_sided) {
         float w = 1.0f;
         if (!unweighted_emission)
-          w = mis_weight(previous_pdf, plan.emitters.pdf(previous_point, ray.direction), plan.heuristic);
+          w = mis_weight(previous_pdf, plan.emitters.pdf(previous_point, ray.direction, reached_quad, aimed_distance),
+                         plan.heuristic);
         radiance += throughput * m.emit * w;
       }
       break;
@@ -94,22 +109,39 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
             intersect_aimed(scene, Ray{origin, ls.direction}, ls.aimed_quad, ls.aimed_distance, shadow_hit)) {
           const Material& lm = scene.materials[shadow_hit.material];
           if (lm.type == MaterialType::DiffuseLight && (dot(ls.direction, shadow_hit.normal) < 0.0f || lm.two_sided)) {
-            const float bsdf_pdf = leaf::cosine_hemisphere_density(cosine);
-            radiance += throughput * m.albedo * lm.emit * leaf::light_sample_weight(bsdf_pdf, ls.pdf, plan.heuristic);
+            const float lambert = leaf::cosine_hemisphere_density(cosine);
+            const float continuation_pdf = plan.cosine_continuation
+                                               ? lambert
+                                               : plan.pdf(origin, normal, ls.direction, ls.aimed_quad, ls.aimed_distance);
+            radiance += throughput * m.albedo * lm.emit *
+                        leaf::light_sample_weight(lambert, continuation_pdf, ls.pdf, plan.heuristic);
           }
         }
       }
     }
 
-    // The material sample: cosine-weighted, so f cos / p is the albedo.
-    const float u1 = rng.uniform(), u2 = rng.uniform();
-    const DirectionSample ds = sample_cosine_hemisphere(Onb(normal), u1, u2);
-    if (!(ds.pdf > 0.0f)) break;  // exactly tangent: the estimate is zero
-    throughput *= m.albedo;
+    if (!roulette_survives(plan, depth, throughput, m.albedo, rng)) break;
+    // The continuation, drawn by the plan's mixture. Cosine alone: f cos / p
+    // is exactly the albedo (the lobe's own z, not a rounded dot product).
+    const DirectionSample ds = plan.sample(origin, normal, rng);
+    if (ds.none) break;  // a target seen edge-on: a valid zero estimate
+    if (!(ds.pdf > 0.0f) || ds.pdf == kInf) {
+      if (!plan.cosine_continuation) drops.add(ds.pdf == kInf || std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
+      break;  // for the cosine lobe: exactly tangent, the estimate is zero
+    }
+    if (plan.cosine_continuation) {
+      throughput *= m.albedo;
+    } else {
+      const float cosine = dot(ds.direction, normal);
+      if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
+      throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
+    }
     previous_pdf = ds.pdf;
     previous_point = origin;
     unweighted_emission = false;
     ray = Ray{origin, ds.direction};
+    aimed_quad = ds.aimed_quad;
+    aimed_distance = ds.aimed_distance;
   }
   if (!is_finite(radiance)) {
     drops.add(DropReason::RadianceNotFinite);
@@ -150,6 +182,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
     if (m.type == MaterialType::Lambertian) {
       // Sampled, and its pdf evaluated, from the point the ray leaves from.
       const Vec3 origin = diffuse_origin(hit, normal);
+      if (!roulette_survives(plan, depth, throughput, m.albedo, rng)) break;
       const DirectionSample ds = plan.sample(origin, normal, rng);
       if (ds.none) break;  // a light seen edge-on: a valid zero estimate
       if (!(ds.pdf > 0.0f)) {

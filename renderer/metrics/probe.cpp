@@ -63,9 +63,10 @@ std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbeP
         const DirectionSample ls = plan.emitters.sample(at.point, uc, u1, u2);
         out.push_back({ls.direction, ls.pdf, ls.none ? -1 : static_cast<int>(Technique::LightSolidAngle)});
       }
-      // ...and one from the cosine lobe.
-      const DirectionSample cs = sample_cosine_hemisphere(Onb(at.normal), rng.uniform(), rng.uniform());
-      out.push_back({cs.direction, cs.pdf, static_cast<int>(Technique::Cosine)});
+      // ...and one from its continuation's mixture (the cosine lobe for plain nee-mis).
+      int technique = 0;
+      const DirectionSample cs = plan.sample(at.point, at.normal, rng, &technique);
+      out.push_back({cs.direction, cs.pdf, cs.none ? -1 : technique});
       continue;
     }
     int technique = 0;
@@ -95,8 +96,8 @@ struct MapFrame {
 float shown_pdf(const SamplingPlan& plan, const ProbePoint& at, const Vec3& d) {
   if (plan.nee_mis) {
     const float light = plan.emitters.empty() ? 0.0f : plan.emitters.pdf(at.point, d);
-    const float cosine = cosine_hemisphere_pdf(at.normal, d);
-    return plan.emitters.empty() ? cosine : 0.5f * (light + cosine);
+    const float continuation = plan.pdf(at.point, at.normal, d);
+    return plan.emitters.empty() ? continuation : 0.5f * (light + continuation);
   }
   return plan.pdf(at.point, at.normal, d);
 }

@@ -57,12 +57,6 @@ void SamplingPlan::bind_targets() {
   target_count = book_targets.size();
 }
 
-void SamplingPlan::use_material_sample_only() {
-  weight[static_cast<int>(Technique::Cosine)] = 1.0f;  // nee-mis's material sample
-  last_technique = static_cast<int>(Technique::Cosine);
-  uses_frame = true;
-}
-
 void SamplingPlan::set_technique_choice(const Strategy& strategy) {
   parameter = strategy.parameters;
   const DiscreteDistribution choice = technique_choice(strategy, usable_weights(strategy, *scene, target_count));
@@ -71,6 +65,9 @@ void SamplingPlan::set_technique_choice(const Strategy& strategy) {
     choice_threshold[i] = choice.thresholds()[static_cast<std::size_t>(i)];
   }
   last_technique = choice.last_positive();
+  int techniques = 0;
+  for (int i = 0; i < kTechniqueCount; ++i) techniques += weight[i] > 0.0f ? 1 : 0;
+  continuation_mixes = techniques > 1;
 #define PDFLAB_ROW(T) \
   uses_frame = uses_frame || (leaf::uses_frame<leaf::T>() && weight[static_cast<int>(Technique::T)] > 0.0f);
   PDFLAB_TECHNIQUES(PDFLAB_ROW)
@@ -82,18 +79,25 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.scene = &scene;
   plan.nee_mis = strategy.nee_mis;
   plan.heuristic = strategy.heuristic;
+  plan.roulette_depth = strategy.roulette_depth;
+  // nee-mis's continuation is a mixture like any other.
+  plan.cosine_continuation = strategy.nee_mis && strategy.cosine_continuation();
   plan.bind_targets();
-  if (strategy.nee_mis) plan.use_material_sample_only();
-  else plan.set_technique_choice(strategy);
+  plan.set_technique_choice(strategy);
   return plan;
 }
 
-float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const {
-  return leaf::mixture_pdf(*this, leaf::Shading(*this, origin, normal, 0.0f, 0.0f, 0), direction, true);
+float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad,
+                        float aimed_t) const {
+  leaf::Shading at(*this, origin, normal, 0.0f, 0.0f, 0);
+  at.aimed_quad = aimed_quad;
+  at.aimed_t = aimed_t;
+  return leaf::mixture_pdf(*this, at, direction, true);
 }
 
 DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
-  const auto u0 = static_cast<std::int32_t>(rng.next_u32());
+  // nee-mis's continuation draws the technique's bits only when it mixes several.
+  const auto u0 = !nee_mis || continuation_mixes ? static_cast<std::int32_t>(rng.next_u32()) : 0;
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
   const int chosen = leaf::choose_technique(*this, u0);

@@ -31,7 +31,7 @@ std::string known_list() {
     out.append(t.name);
     if (!t.parameter.empty()) out.append("[:").append(t.parameter).append("]");
   }
-  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance";
+  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +rr or +rr:D)";
 }
 
 std::string format_number(float x) {
@@ -95,7 +95,17 @@ std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)
 
 std::string strategy_help() {
   std::string out =
-      "Strategies: TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...] | nee-mis | nee-mis:balance\nTechniques:\n";
+      "Strategies: BASE[+rr[:D]] | fastest\n"
+      "  BASE := MIXTURE | nee-mis[:balance][+MIXTURE]\n"
+      "  MIXTURE := TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...]\n"
+      "  nee-mis: a light sample and a continuation at each diffuse vertex, weighed by MIS (power heuristic,\n"
+      "    :balance the balance heuristic); the continuation is drawn by MIXTURE (default cosine), e.g.\n"
+      "    nee-mis+mix:cosine=0.5,light=0.5 keeps aiming at the book's glass sphere\n"
+      "  +rr[:D]: Russian roulette from D path segments on (default " + std::to_string(kDefaultRouletteDepth) +
+      "): a path goes on with probability\n"
+      "    min(1, largest throughput component), its throughput divided by it (unbiased; off by default)\n"
+      "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +
+      "\nTechniques:\n";
   for (const TechniqueInfo& t : kTable) {
     std::string name(t.name);
     if (!t.parameter.empty())
@@ -124,30 +134,30 @@ Strategy Strategy::single(Technique t) {
 }
 
 Strategy Strategy::nee(MisHeuristic h) {
-  Strategy s;
+  Strategy s = single(Technique::Cosine);
   s.nee_mis = true;
   s.heuristic = h;
   return s;
 }
 
-Strategy Strategy::parse(std::string_view text) {
-  const std::string_view whole = trim(text);
-  if (whole.empty()) throw InputError("empty strategy; expected one of: " + known_list());
-  if (whole == "nee-mis" || whole == "nee-mis:power") return nee(MisHeuristic::Power);
-  if (whole == "nee-mis:balance") return nee(MisHeuristic::Balance);
-  if (whole.substr(0, 8) == "nee-mis:")
-    throw InputError("strategy '" + std::string(whole) + "': the heuristic must be 'power' or 'balance'");
+namespace {
+
+// TECHNIQUE or mix:TECHNIQUE=W,... (`whole` is the full text, for messages).
+Strategy parse_mixture(std::string_view text, std::string_view whole) {
+  if (text.empty()) throw InputError("strategy '" + std::string(whole) + "': the mixture is empty");
+  if (text.find('+') != std::string_view::npos)
+    throw InputError("strategy '" + std::string(whole) + "': '+' joins only nee-mis, its continuation and rr");
   constexpr std::string_view kMix = "mix:";
-  if (whole.substr(0, kMix.size()) != kMix) {
-    const ParsedTechnique p = parse_technique(whole, whole);
-    Strategy s = single(p.technique);
+  if (text.substr(0, kMix.size()) != kMix) {
+    const ParsedTechnique p = parse_technique(text, whole);
+    Strategy s = Strategy::single(p.technique);
     s.parameters[static_cast<int>(p.technique)] = p.parameter;
     return s;
   }
 
   Strategy s;
   std::array<bool, kTechniqueCount> seen{};
-  std::string_view rest = whole.substr(kMix.size());
+  std::string_view rest = text.substr(kMix.size());
   if (trim(rest).empty()) throw InputError("strategy '" + std::string(whole) + "': the mixture lists no technique");
   while (true) {
     const size_t comma = rest.find(',');
@@ -174,8 +184,86 @@ Strategy Strategy::parse(std::string_view text) {
   return s;
 }
 
+// rr or rr:D.
+int parse_roulette(std::string_view text, std::string_view whole) {
+  if (text == "rr") return kDefaultRouletteDepth;
+  const std::string_view depth = text.substr(text.find(':') + 1);
+  int value = 0;
+  const auto* end = depth.data() + depth.size();
+  auto [ptr, ec] = std::from_chars(depth.data(), end, value);
+  if (text.substr(0, 3) != "rr:" || depth.empty() || ec != std::errc() || ptr != end || value < 1 ||
+      value > kMaxRouletteDepth)
+    throw InputError("strategy '" + std::string(whole) + "': '" + std::string(text) +
+                     "' is not rr or rr:D with D, the first depth of Russian roulette, an integer in 1.." +
+                     std::to_string(kMaxRouletteDepth));
+  return value;
+}
+
+}  // namespace
+
+Strategy Strategy::parse(std::string_view text) {
+  const std::string_view whole = trim(text);
+  if (whole.empty()) throw InputError("empty strategy; expected one of: " + known_list());
+  std::string_view body = whole;
+  // A last term `rr[:D]` turns on Russian roulette.
+  int roulette = 0;
+  const std::size_t last_plus = body.rfind('+');
+  if (last_plus != std::string_view::npos && trim(body.substr(last_plus + 1)).substr(0, 2) == "rr") {
+    roulette = parse_roulette(trim(body.substr(last_plus + 1)), whole);
+    body = trim(body.substr(0, last_plus));
+  }
+  Strategy s;
+  if (body == "fastest") {
+    s = parse(kFastestStrategy);
+    s.fastest = true;
+    if (roulette) s.roulette_depth = roulette;
+    return s;
+  }
+  if (body.substr(0, 7) == "nee-mis") {
+    const std::size_t plus = body.find('+');
+    const std::string_view head = trim(body.substr(0, plus));
+    MisHeuristic h = MisHeuristic::Power;
+    if (head == "nee-mis" || head == "nee-mis:power") h = MisHeuristic::Power;
+    else if (head == "nee-mis:balance") h = MisHeuristic::Balance;
+    else if (head.substr(0, 8) == "nee-mis:")
+      throw InputError("strategy '" + std::string(whole) + "': the heuristic must be 'power' or 'balance'");
+    else
+      throw InputError("unknown strategy '" + std::string(whole) + "'; expected one of: " + known_list());
+    s = nee(h);
+    if (plus != std::string_view::npos) {
+      const Strategy continuation = parse_mixture(trim(body.substr(plus + 1)), whole);
+      s.weights = continuation.weights;
+      s.parameters = continuation.parameters;
+    }
+  } else {
+    s = parse_mixture(body, whole);
+  }
+  s.roulette_depth = roulette;
+  return s;
+}
+
+bool Strategy::cosine_continuation() const {
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if ((weights[i] > 0.0f) != (static_cast<Technique>(i) == Technique::Cosine)) return false;
+  return true;
+}
+
 std::string Strategy::to_string() const {
-  if (nee_mis) return heuristic == MisHeuristic::Power ? "nee-mis" : "nee-mis:balance";
+  std::string out;
+  if (nee_mis) {
+    out = heuristic == MisHeuristic::Power ? "nee-mis" : "nee-mis:balance";
+    if (!cosine_continuation()) out.append("+").append(mixture_string());
+  } else {
+    out = mixture_string();
+  }
+  if (roulette_depth > 0) {
+    out.append("+rr");
+    if (roulette_depth != kDefaultRouletteDepth) out.append(":").append(std::to_string(roulette_depth));
+  }
+  return out;
+}
+
+std::string Strategy::mixture_string() const {
   int used = 0, last = 0;
   for (int i = 0; i < kTechniqueCount; ++i)
     if (weights[i] > 0.0f) ++used, last = i;
@@ -202,7 +290,6 @@ std::string Strategy::to_string() const {
 }
 
 bool Strategy::is_unbiased() const {
-  if (nee_mis) return true;
   for (int i = 0; i < kTechniqueCount; ++i)
     if (kTable[i].covers_hemisphere && uses(static_cast<Technique>(i))) return true;
   return false;

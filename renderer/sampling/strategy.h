@@ -25,32 +25,66 @@ const TechniqueInfo& technique_info(Technique t);
 std::string strategy_help();
 std::string_view technique_name(Technique t);
 
+// What `fastest` expands to: pdflab's most efficient unbiased strategy for
+// general scenes, by measurement on the shipped scenes (docs/convergence.md).
+inline constexpr std::string_view kFastestStrategy = "nee-mis+mix:cosine=0.5,light=0.5+rr";
+
+// Russian roulette's default first depth, and the largest one accepted.
+inline constexpr int kDefaultRouletteDepth = 3;
+inline constexpr int kMaxRouletteDepth = 10000;
+
 // As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,
-// `nee-mis:balance`... Mixture weights are kept as given (normalised by
-// SamplingPlan). Parsing validates; see README.md.
+// `nee-mis:balance`, `nee-mis+mix:cosine=0.5,light=0.5`, any of them with
+// `+rr` or `+rr:D`, or `fastest`... Mixture weights are kept as given
+// (normalised by SamplingPlan). Parsing validates; see README.md.
 struct Strategy {
+  // The techniques that draw the direction at a diffuse bounce; for nee-mis,
+  // the continuation's (cosine alone for plain `nee-mis`).
   std::array<float, kTechniqueCount> weights{};
   // Each technique's parameter (TechniqueInfo::parameter; `cosine-power:8`),
   // its default where the technique has one, else 0.
   std::array<float, kTechniqueCount> parameters = default_parameters();
   // Next-event estimation: at each diffuse vertex one light sample (shadow ray,
-  // solid-angle sampling of the emitters chosen by power) and one cosine
-  // sample, combined with multiple importance sampling. `weights` is unused.
+  // solid-angle sampling of the emitters chosen by power) and one sample of
+  // `weights` that continues the path, combined with multiple importance
+  // sampling.
   bool nee_mis = false;
   MisHeuristic heuristic = MisHeuristic::Power;
+  // Russian roulette from path depth D = roulette_depth on (0: off, the book's
+  // estimator): at a diffuse vertex whose continuation would be segment D or
+  // later (the camera ray is segment 0), before the continuation is drawn, the
+  // path goes on with probability min(1, largest component of throughput *
+  // albedo), its throughput divided by that (leaf::russian_roulette).
+  int roulette_depth = 0;
+  // Parsed from `fastest`: the fields above are what it expanded to
+  // (kFastestStrategy), which to_string gives; sidecars record both.
+  bool fastest = false;
 
   static std::array<float, kTechniqueCount> default_parameters();
   static Strategy parse(std::string_view text);  // throws InputError
   static Strategy single(Technique t);
   static Strategy nee(MisHeuristic h = MisHeuristic::Power);
   std::string to_string() const;  // canonical form, parses back to the same value
+  // The continuation of a nee-mis strategy is cosine alone (plain `nee-mis`).
+  bool cosine_continuation() const;
 
   // Unbiased iff some technique with positive weight covers the whole
-  // hemisphere above a diffuse surface (TechniqueInfo::covers_hemisphere).
+  // hemisphere above a diffuse surface (TechniqueInfo::covers_hemisphere);
+  // for nee-mis, the continuation's. Russian roulette changes nothing here.
   bool is_unbiased() const;
-  bool uses(Technique t) const { return !nee_mis && weights[static_cast<int>(t)] > 0.0f; }
+  bool uses(Technique t) const { return weights[static_cast<int>(t)] > 0.0f; }
   bool operator==(const Strategy&) const = default;
+
+ private:
+  std::string mixture_string() const;  // the techniques and weights alone
 };
+
+// `strategy` with Russian roulette from `depth` on (the command lines' --rr);
+// depth 0 leaves it as it is.
+inline Strategy with_roulette(Strategy strategy, int depth) {
+  if (depth > 0) strategy.roulette_depth = depth;
+  return strategy;
+}
 
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
 // distribution, and the target sets. Built once per render; it points into the
@@ -68,6 +102,11 @@ struct SamplingPlan {
   const Scene* scene = nullptr;
   bool nee_mis = false;
   MisHeuristic heuristic = MisHeuristic::Power;
+  // nee-mis: the continuation is cosine alone, whose f cos / p is exactly the
+  // albedo; with several techniques in it the continuation draws u0 to choose.
+  bool cosine_continuation = false;
+  bool continuation_mixes = false;
+  int roulette_depth = 0;  // Strategy::roulette_depth
 
   TargetSet book_targets;   // `light`: the importance targets, chosen uniformly
   TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
@@ -83,14 +122,14 @@ struct SamplingPlan {
   // sum_i w_i p_i(direction). `normal` faces the incoming ray's side.
   // `technique`, when given, receives which technique drew the direction.
   DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr) const;
-  // The mixture's pdf for any unit direction.
-  float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
+  // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
+  float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
+            float aimed_t = 0.0f) const;
 
-  // The steps of make, once `scene` is set: the target sets; then either
-  // nee-mis's one material sample, or the strategy's techniques with their
+  // The steps of make, once `scene` is set: the target sets; then the
+  // strategy's techniques (for nee-mis, its continuation's) with their
   // realised shares.
   void bind_targets();
-  void use_material_sample_only();
   void set_technique_choice(const Strategy& strategy);
 };
 

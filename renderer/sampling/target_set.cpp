@@ -22,21 +22,26 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   for (auto& sp : spheres) sp.probability = choice.pmf(i++);
 }
 
-float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const {
+float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip, int aimed_quad,
+                             float aimed_t) const {
   float sum = 0.0f;
   if (solid_angle) {
     for (const QuadEntry& e : quads)
-      if (e.quad != skip) sum += e.probability * quad_solid_angle_pdf(*e.quad, origin, direction);
+      if (e.quad != skip)
+        sum += e.probability * quad_solid_angle_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
   } else {
     for (const QuadEntry& e : quads)
-      if (e.quad != skip) sum += e.probability * quad_area_pdf(*e.quad, origin, direction);
+      if (e.quad != skip)
+        sum += e.probability * leaf::quad_area_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
   }
   for (const SphereEntry& e : spheres)
     if (e.sphere != skip) sum += e.probability * sphere_cone_pdf(*e.sphere, origin, direction);
   return sum;
 }
 
-float TargetSet::pdf(const Vec3& origin, const Vec3& direction) const { return pdf_without(origin, direction, nullptr); }
+float TargetSet::pdf(const Vec3& origin, const Vec3& direction, int aimed_quad, float aimed_t) const {
+  return pdf_without(origin, direction, nullptr, aimed_quad, aimed_t);
+}
 
 DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const {
   if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at

@@ -42,10 +42,14 @@ struct TargetSet {
   // pdf being the set's: sum over targets of probability * per-target pdf. The
   // chosen target's density comes from its sampler, the others' from evaluation.
   DirectionSample sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const;
-  float pdf(const Vec3& origin, const Vec3& direction) const;
+  // `aimed_quad` (an index in Scene::quads, -1: none): the direction is known to
+  // reach that quad at distance aimed_t (DirectionSample::aimed_quad), so its
+  // term holds even for a sliver float's intersection test would miss.
+  float pdf(const Vec3& origin, const Vec3& direction, int aimed_quad = -1, float aimed_t = 0.0f) const;
 
  private:
-  float pdf_without(const Vec3& origin, const Vec3& direction, const void* skip) const;
+  float pdf_without(const Vec3& origin, const Vec3& direction, const void* skip, int aimed_quad = -1,
+                    float aimed_t = 0.0f) const;
 };
 
 // `light`'s set: the scene's importance targets, chosen uniformly.

@@ -81,9 +81,9 @@ DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, fl
           static_cast<float>(1.0 / r.solid_angle), false, -1, static_cast<float>(distance)};
 }
 
-float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction) {
+float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction, bool aimed, float aimed_t) {
   // Cheap rejection first: most directions miss the quad.
-  const float t = quad_hit_distance(quad, origin, direction);
+  const float t = aimed ? aimed_t : quad_hit_distance(quad, origin, direction);
   if (t < 0.0f) return 0.0f;
   const SphericalRectangle r = spherical_rectangle(quad, origin);
   if (!r.usable) {

@@ -105,6 +105,8 @@ inline bool quad_is_rectangle(const Quad& quad) {
 SphericalRectangle spherical_rectangle(const Quad& quad, const Vec3& origin);
 
 DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, float u1, float u2);
-float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction);
+// `aimed`: the direction is known to reach the quad at distance aimed_t (leaf::quad_area_pdf).
+float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& direction, bool aimed = false,
+                           float aimed_t = 0.0f);
 
 }  // namespace pdflab
