@@ -416,6 +416,7 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
                                                                   ? "MEASURED against the reference"
                                                                   : "ESTIMATED from the film's own variance");
     if (ImGui::BeginTable("figures", 2, ImGuiTableFlags_SizingStretchProp)) {
+      share_columns({0.56f, 0.44f});
       if (f.against_reference) {
         figure_row("RMSE", "root mean squared error against the reference, all pixels and channels", "%.5g", f.rmse);
         text_row("relMSE (eps 1e-2)",

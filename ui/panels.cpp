@@ -309,6 +309,7 @@ void statistics_section(const ViewerSettings& settings, const UiStatus& status) 
   const SessionStats& st = status.stats;
   const std::uint64_t dropped = st.dropped.total();
   if (ImGui::BeginTable("stats", 4, ImGuiTableFlags_SizingStretchProp)) {
+    share_columns({0.22f, 0.28f, 0.22f, 0.28f});
     stat_cell("spp", "%u%s", st.spp, st.done ? " done" : (st.paused ? " paused" : ""));
     stat_cell("elapsed", "%s", format_seconds(st.seconds).c_str());
     stat_cell("samples/s", "%.3f M", st.samples_per_second * 1e-6);
