@@ -13,6 +13,14 @@ std::string_view drop_reason_name(DropReason r) {
 
 namespace {
 
+// A path's estimate as it leaves the tracer: a value that is not finite is
+// dropped (counted, and zero in its place).
+Vec3 checked_radiance(const Vec3& radiance, DropCounts& drops) {
+  if (is_finite(radiance)) return radiance;
+  drops.add(DropReason::RadianceNotFinite);
+  return Vec3(0.0f);
+}
+
 // Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
 // ray); returns false when the path ends (absorbed). The scatter rules are
 // leaf math (metal_direction, dielectric_setup / dielectric_direction).
@@ -143,11 +151,7 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
     aimed_quad = ds.aimed_quad;
     aimed_distance = ds.aimed_distance;
   }
-  if (!is_finite(radiance)) {
-    drops.add(DropReason::RadianceNotFinite);
-    return Vec3(0.0f);
-  }
-  return radiance;
+  return checked_radiance(radiance, drops);
 }
 
 }  // namespace
@@ -206,11 +210,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       break;
     }
   }
-  if (!is_finite(radiance)) {
-    drops.add(DropReason::RadianceNotFinite);
-    return Vec3(0.0f);
-  }
-  return radiance;
+  return checked_radiance(radiance, drops);
 }
 
 namespace {

@@ -75,43 +75,32 @@ int packet_lanes(PacketIsa isa) {
   return packet_generic::W;
 }
 
+// Calls the kernel compiled for `isa` (AVX2 only where the build dispatches).
+#if PDFLAB_PACKET_DISPATCH
+#define PDFLAB_PACKET_CALL(isa, call)                          \
+  if ((isa) == PacketIsa::Avx2) return packet_avx2::call; \
+  return packet_generic::call
+#else
+#define PDFLAB_PACKET_CALL(isa, call) \
+  (void)(isa);                        \
+  return packet_generic::call
+#endif
+
 void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
                  const SampleBlock& block, SampleResult* out) {
-#if PDFLAB_PACKET_DISPATCH
-  if (isa == PacketIsa::Avx2) {
-    packet_avx2::trace_block_impl(scene, plan, seed, block, out);
-    return;
-  }
-#else
-  (void)isa;
-#endif
-  packet_generic::trace_block_impl(scene, plan, seed, block, out);
+  PDFLAB_PACKET_CALL(isa, trace_block_impl(scene, plan, seed, block, out));
 }
 
 void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out) {
-#if PDFLAB_PACKET_DISPATCH
-  if (isa == PacketIsa::Avx2) {
-    packet_avx2::sample_plan_impl(plan, draws, n, out);
-    return;
-  }
-#else
-  (void)isa;
-#endif
-  packet_generic::sample_plan_impl(plan, draws, n, out);
+  PDFLAB_PACKET_CALL(isa, sample_plan_impl(plan, draws, n, out));
 }
 
 void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,
               float* out) {
-#if PDFLAB_PACKET_DISPATCH
-  if (isa == PacketIsa::Avx2) {
-    packet_avx2::plan_pdf_impl(plan, draws, directions, n, out);
-    return;
-  }
-#else
-  (void)isa;
-#endif
-  packet_generic::plan_pdf_impl(plan, draws, directions, n, out);
+  PDFLAB_PACKET_CALL(isa, plan_pdf_impl(plan, draws, directions, n, out));
 }
+
+#undef PDFLAB_PACKET_CALL
 
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
                  SampleResult* out) {
