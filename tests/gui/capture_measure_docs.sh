@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the measuring figures in docs/: the noise heat map, the
-# difference to a reference, the drop overlay, the convergence plot with a
+# difference to a reference, its relative squared error with the panel's
+# metric and range controls, the drop overlay, the convergence plot with a
 # pinned curve, and the nee-mis note. The book's scene at 400x400 under Xvfb.
 #   tests/gui/capture_measure_docs.sh [PDFLAB] [SECONDS_PER_STRATEGY]
 set -euo pipefail
@@ -36,6 +37,14 @@ shot view_heatmap.png
 send_key v
 sleep 2
 shot view_difference.png
+# The relative squared error (E four times from the signed error), with the
+# panel scrolled down to the view's metric and range.
+for _ in 1 2 3 4; do send_key e; done
+xdotool mousemove "$((WIDTH - 200))" "$((HEIGHT / 2))"
+for _ in $(seq 25); do xdotool click 5; sleep 0.03; done
+xdotool mousemove 5 5
+sleep 2
+shot view_metric.png
 send_key v
 send_key v   # back to the image
 send_key g   # the plot on (it starts hidden)
