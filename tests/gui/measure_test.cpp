@@ -34,6 +34,14 @@ PublishedImage flat_image(int w, int h, float value, std::uint32_t spp = 4) {
   return img;
 }
 
+ReferenceImage flat_reference(int w, int h, float value) {
+  ReferenceImage ref;
+  ref.width = w;
+  ref.height = h;
+  ref.rgb.assign(3 * static_cast<std::size_t>(w) * h, value);
+  return ref;
+}
+
 }  // namespace
 
 TEST(Convergence, RecordsPassesAndStartsANewCurvePerGeneration) {
@@ -312,11 +320,7 @@ TEST(ColourMaps, LegendOfASetRangeLabelsBothEndsAndRoundValuesBetween) {
 
 TEST(ViewLayer, MetricAndRangeChangesRebuildTheLayerInTheirColours) {
   MeasureState m;
-  ReferenceImage ref;
-  ref.width = 2;
-  ref.height = 1;
-  ref.rgb.assign(6, 0.5f);
-  m.set_reference(ref);
+  m.set_reference(flat_reference(2, 1, 0.5f));
   m.published = flat_image(2, 1, 0.625f);  // an error of 1/8, exactly
   MeasureSettings s;
   s.view_mode = ViewMode::Difference;
@@ -438,12 +442,8 @@ TEST(MeasureState, RenderAtReferenceSizeThenMeasures) {
   // The viewer's flow: a mismatched reference gives estimates only; at the
   // reference's size the next image is measured against it.
   MeasureState m;
-  ReferenceImage ref;
-  ref.width = 4;
-  ref.height = 2;
-  ref.rgb.assign(24, 0.5f);
   m.published = flat_image(8, 8, 0.5f);
-  m.set_reference(ref);
+  m.set_reference(flat_reference(4, 2, 0.5f));
   EXPECT_FALSE(m.size_mismatch(8, 8).empty());
   EXPECT_FALSE(m.figures.against_reference);
   m.published = flat_image(4, 2, 0.55f);
