@@ -37,9 +37,9 @@ shot dropdown_closed "$panel_top"
 changed "$art/dropdown.png" "$art/dropdown_closed.png" 0.03
 
 echo "== Esc while editing a text field"
-field="300x22+$((px + 8))+151"
+field="300x22+$((px + 8))+201"
 shot field_before "$field"
-xdotool mousemove "$((px + 200))" 162 click 1
+xdotool mousemove "$((px + 200))" 212 click 1
 sleep 0.2
 send_key End
 xdotool type --window "$wid" "xyz"
