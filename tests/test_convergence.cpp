@@ -213,7 +213,7 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
                       {"nee-mis:balance", 128, false},
                       {"mix:cosine=0.5,light-sa=0.5+rr", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5", 128, false},
-                      {"fastest", 128, false}};
+                      {"fastest", 256, false}};  // today the book mixture: its spp
   constexpr int kSmall = 24;
   const int tests = static_cast<int>(std::size(scenes) * std::size(runs)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
   const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));

@@ -273,6 +273,45 @@ void expect_rejected(const std::string& text, std::initializer_list<const char*>
                                                        << needle << "'";
 }
 
+// nee-mis continued by a mixture, Russian roulette, fastest: their parts,
+// canonical forms that parse back, what is unbiased, and clear refusals.
+TEST(StrategyParse, ContinuationsRouletteAndFastest) {
+  const Strategy nm = Strategy::parse("nee-mis+mix:cosine=0.5,light=0.5");
+  EXPECT_TRUE(nm.nee_mis);
+  EXPECT_FALSE(nm.cosine_continuation());
+  EXPECT_TRUE(nm.uses(Technique::Light));
+  EXPECT_EQ(nm.to_string(), "nee-mis+mix:cosine=0.5,light=0.5");
+  EXPECT_TRUE(nm.is_unbiased());
+  EXPECT_FALSE(Strategy::parse("nee-mis+light").is_unbiased());  // the continuation never sees indirect light
+  EXPECT_EQ(Strategy::parse("nee-mis+cosine"), Strategy::parse("nee-mis"));
+  EXPECT_EQ(Strategy::parse("nee-mis").to_string(), "nee-mis");
+  EXPECT_EQ(Strategy::parse("cosine").roulette_depth, 0);
+  EXPECT_EQ(Strategy::parse("cosine+rr").roulette_depth, kDefaultRouletteDepth);
+  EXPECT_EQ(Strategy::parse("nee-mis:balance+light-sa+rr:7").roulette_depth, 7);
+  EXPECT_TRUE(Strategy::parse("nee-mis:balance+light-sa+rr:7").is_unbiased() == false);
+  for (const char* text : {"cosine+rr", "cosine+rr:1", "mix:cosine=1,light=3+rr:12", "nee-mis+rr",
+                           "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2", "nee-mis+uniform-sphere"}) {
+    const Strategy s = Strategy::parse(text);
+    const Strategy back = Strategy::parse(s.to_string());
+    EXPECT_EQ(back.to_string(), s.to_string()) << text;
+    EXPECT_EQ(back.roulette_depth, s.roulette_depth) << text;
+    EXPECT_EQ(back.nee_mis, s.nee_mis) << text;
+  }
+  EXPECT_EQ(with_roulette(Strategy::parse("cosine"), 5).to_string(), "cosine+rr:5");
+  EXPECT_EQ(with_roulette(Strategy::parse("cosine+rr:2"), 0).to_string(), "cosine+rr:2");
+  const Strategy fastest = Strategy::parse("fastest");
+  EXPECT_TRUE(fastest.fastest);
+  EXPECT_TRUE(fastest.is_unbiased());
+  EXPECT_EQ(fastest.to_string(), Strategy::parse(kFastestStrategy).to_string());  // what it expanded to
+  EXPECT_EQ(Strategy::parse("fastest+rr:4").roulette_depth, 4);
+  expect_rejected("cosine+rr:0", {"'rr:0'", "1..10000"});
+  expect_rejected("cosine+rr:x", {"'rr:x'"});
+  expect_rejected("cosine+light", {"'+' joins only"});
+  expect_rejected("nee-mis+", {"mixture is empty"});
+  expect_rejected("nee-mis+nee-mis", {"cannot be mixed"});
+  expect_rejected("nee-mis:fast+cosine", {"'power' or 'balance'"});
+}
+
 TEST(StrategyParse, Rejections) {
   expect_rejected("phong", {"unknown strategy 'phong'", "cosine"});
   expect_rejected("Cosine", {"unknown strategy"});
