@@ -1,5 +1,6 @@
 #include "app/bench_command.h"
 
+#include "app/measured_run.h"
 #include "app/reference_command.h"
 
 #include "renderer/error.h"
@@ -54,48 +55,29 @@ void write_text(const std::string& path, const std::string& text) {
 
 Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, const BenchOptions& o,
                const Reference& reference, const std::string& progress_prefix, bool show_progress) {
-  RenderSession session(o.threads);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = strategy;
-  settings.seed = o.seed;
-  settings.target_spp = o.spp;  // 0 with --seconds: until paused
-  session.set_settings(settings);
-
   Result r;
   r.strategy = strategy;
   std::vector<float> image;
   std::uint64_t version = 0;
-  for (;;) {
-    const bool done = session.wait_until_done(std::chrono::milliseconds(25));
-    SessionStats st = session.stats();
+  char label[128];
+  std::snprintf(label, sizeof label, "%s %-32s", progress_prefix.c_str(), strategy.to_string().c_str());
+  const MeasuredRun run = render_measured(scene, strategy, o.seed, {o.seconds, o.spp, o.threads}, label, show_progress,
+                                          [&](RenderSession& session) {
     ImageInfo info;
     // The info describes the very image copied (its pass's spp and time); previews are not estimates.
     if (session.copy_image(image, info, version) && !info.preview && info.spp > 0) {
       const RelMseMeasure m = measure_relmse(image, reference.rgb, reference.variance);
       r.curve.push_back({info.spp, info.seconds, rmse(image, reference.rgb), m.corrected, m.raw});
     }
-    if (show_progress) {
-      const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
-      std::fprintf(stderr, "\r%s %-32s %5.1f%%  %u spp  %.1f s   ", progress_prefix.c_str(),
-                   strategy.to_string().c_str(), 100.0 * std::min(1.0, frac), st.spp, st.seconds);
-      std::fflush(stderr);
-    }
-    if (done) break;
-    if (o.seconds > 0 && st.seconds >= o.seconds) {
-      session.set_paused(true);
-      break;
-    }
-  }
-  const Film film = session.copy_film();  // waits for the pass in flight
-  const SessionStats st = session.stats();
-  const std::vector<float> final_image = film.mean_rgb();
+  });
+  const SessionStats& st = run.stats;
+  const std::vector<float> final_image = run.film.mean_rgb();
   r.spp = st.spp;
   r.seconds = st.seconds;
   r.rmse = rmse(final_image, reference.rgb);
   r.error = measure_relmse(final_image, reference.rgb, reference.variance);
   r.efficiency = efficiency(r.error.corrected, r.seconds);
-  r.estimated_relmse = estimated_relmse(film);
+  r.estimated_relmse = estimated_relmse(run.film);
   r.samples_per_second = st.samples_per_second;
   r.dropped = st.dropped.total();
   if (r.curve.empty() || r.curve.back().spp != r.spp)

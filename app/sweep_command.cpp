@@ -1,6 +1,7 @@
 #include "app/sweep_command.h"
 
 #include "app/bench_command.h"
+#include "app/measured_run.h"
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
@@ -68,90 +69,6 @@ std::vector<double> parse_weights(const std::string& text) {
   return out;
 }
 
-// A strategy's canonical text as (technique, weight) pairs: "cosine" or
-// "mix:cosine=0.25,light=0.75". The text, not the strategy's fields, so the
-// sweep needs nothing of how a strategy stores its weights.
-std::vector<std::pair<std::string, double>> mixture_terms(const Strategy& s) {
-  const std::string text = s.to_string();
-  if (text.rfind("mix:", 0) != 0) return {{text, 1.0}};
-  std::vector<std::pair<std::string, double>> terms;
-  std::stringstream ss(text.substr(4));
-  std::string term;
-  while (std::getline(ss, term, ',')) {
-    const std::size_t eq = term.find('=');
-    terms.emplace_back(term.substr(0, eq), std::stod(term.substr(eq + 1)));
-  }
-  return terms;
-}
-
-struct Family {
-  std::string a, b;
-  double share = 1.0;                                 // the pair's total weight
-  std::vector<std::pair<std::string, double>> rest;  // the others, normalised weights
-  int roulette_depth = 0;                             // Strategy::roulette_depth of every run
-
-  Strategy at(double w) const {
-    char buf[64];
-    std::string text = "mix:";
-    std::snprintf(buf, sizeof buf, "%s=%.9g,%s=%.9g", a.c_str(), share * w, b.c_str(), share * (1.0 - w));
-    text += buf;
-    for (const auto& [name, weight] : rest) {
-      std::snprintf(buf, sizeof buf, ",%s=%.9g", name.c_str(), weight);
-      text += buf;
-    }
-    return with_roulette(Strategy::parse(text), roulette_depth);
-  }
-  MixtureFamily mixture_family() const {
-    MixtureFamily m;
-    m.a = Strategy::parse(a);
-    m.b = Strategy::parse(b);
-    m.share = rest.empty() ? 1.0 : share;
-    if (!rest.empty()) {
-      std::string text = "mix:";
-      for (const auto& [name, weight] : rest) text += (text.size() > 4 ? "," : "") + name + "=" + std::to_string(weight);
-      m.rest = Strategy::parse(text);
-    }
-    return m;
-  }
-};
-
-Family parse_family(const std::string& vary, const std::string& base, int roulette_depth) {
-  const std::size_t comma = vary.find(',');
-  if (comma == std::string::npos || vary.find(',', comma + 1) != std::string::npos)
-    throw InputError("--vary '" + vary + "' is not two techniques A,B (for example cosine,light)");
-  Family f;
-  f.roulette_depth = roulette_depth;
-  for (std::string* name : {&f.a, &f.b}) {
-    *name = trim(name == &f.a ? vary.substr(0, comma) : vary.substr(comma + 1));
-    Strategy s;
-    try {
-      s = Strategy::parse(*name);
-    } catch (const InputError& e) {  // an unknown name: the message lists the known ones
-      throw InputError("--vary '" + vary + "': " + e.what());
-    }
-    if (s.nee_mis || s.to_string().rfind("mix:", 0) == 0)
-      throw InputError("--vary '" + vary + "': '" + *name + "' is not a mixture technique");
-    *name = s.to_string();  // canonical, as the base mixture's terms are written
-  }
-  if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
-  if (base.empty()) return f;
-  Strategy s = Strategy::parse(base);
-  if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
-  s.roulette_depth = 0;  // the mixture's terms alone
-  if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
-  double pair = 0.0;
-  for (const auto& [name, weight] : mixture_terms(s))
-    if (name == f.a || name == f.b)
-      pair += weight;
-    else
-      f.rest.emplace_back(name, weight);
-  if (!(pair > 0.0))
-    throw InputError("--strategy '" + base + "' gives " + f.a + " and " + f.b +
-                     " no weight: the sweep would hold them at zero");
-  f.share = pair;
-  return f;
-}
-
 // Two-sided 97.5 % quantiles of Student's t for 1..30 degrees of freedom.
 double t_quantile(int dof) {
   static constexpr double kT[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
@@ -189,38 +106,16 @@ struct Run {
 Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                 const SweepOptions& o, const Reference& reference, const std::string& label,
                 bool show_progress, std::vector<float>* image = nullptr) {
-  RenderSession session(o.threads);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = strategy;
-  settings.seed = seed;
-  settings.target_spp = o.spp;  // 0 with --seconds: until paused
-  session.set_settings(settings);
-  for (;;) {
-    const bool done = session.wait_until_done(std::chrono::milliseconds(25));
-    const SessionStats st = session.stats();
-    if (show_progress) {
-      const double frac = o.seconds > 0 ? st.seconds / o.seconds : st.progress;
-      std::fprintf(stderr, "\r%s %5.1f%%  %u spp   ", label.c_str(), 100.0 * std::min(1.0, frac), st.spp);
-      std::fflush(stderr);
-    }
-    if (done) break;
-    if (o.seconds > 0 && st.seconds >= o.seconds) {
-      session.set_paused(true);
-      break;
-    }
-  }
-  const Film film = session.copy_film();  // waits for the pass in flight
-  const SessionStats st = session.stats();
+  const MeasuredRun run = render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads}, label, show_progress);
   Run r;
-  r.spp = st.spp;
-  r.seconds = st.seconds;
+  r.spp = run.stats.spp;
+  r.seconds = run.stats.seconds;
   // Corrected for the reference's own noise when it has a variance (as bench does).
-  const std::vector<float> mean = film.mean_rgb();
+  const std::vector<float> mean = run.film.mean_rgb();
   r.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
   if (image) *image = mean;
   r.efficiency = efficiency(r.relmse, r.seconds);
-  r.samples_per_second = st.samples_per_second;
+  r.samples_per_second = run.stats.samples_per_second;
   return r;
 }
 
@@ -233,7 +128,7 @@ struct AutoRun {
   std::vector<double> weights;  // per pass
 };
 
-AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const Family& family, const MixtureFamily& mixtures,
+AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePair& family, const MixtureFamily& mixtures,
                     std::uint64_t seed, const SweepOptions& o, const Reference& reference, const std::string& label,
                     bool show_progress) {
   constexpr double kShare[4] = {0.125, 0.125, 0.25, 0.5};
@@ -352,7 +247,7 @@ int run_sweep(const SweepOptions& o) {
   if (!o.map.empty()) check_output_path(o.map);
   check_distinct_outputs({o.csv, o.plot, o.map});
   const std::vector<double> weights = parse_weights(o.weights);
-  const Family family = parse_family(o.vary, o.strategy, o.roulette_depth);
+  const TechniquePair family = parse_technique_pair(o.vary, o.strategy, o.roulette_depth);
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   // Every strategy of the sweep is checked against the scene before the first render.
   std::vector<Row> rows;

@@ -1,7 +1,7 @@
 // `pdflab bench` on the real binary: every class of bad input exits 2 with a
 // message naming the problem and writes nothing; a tiny run writes a CSV with
 // the documented columns, a curves CSV and a well-formed SVG plot.
-#include "tests/support.h"
+#include "tests/command_test.h"
 
 #include <gtest/gtest.h>
 
@@ -133,24 +133,11 @@ std::vector<std::map<std::string, std::string>> parse_csv(const std::string& tex
   return ::testing::AssertionSuccess();
 }
 
-class BenchCommand : public ::testing::Test {
+class BenchCommand : public pdflab::testing::CommandTest {
  protected:
-  fs::path work() const { return ws_.work(); }
-  std::string in_work(const std::string& name) const { return ws_.in_work(name); }
-  std::vector<std::string> work_entries() const { return ws_.work_entries(); }
-  ChildResult run(const std::vector<std::string>& args) const {
-    const ChildResult r = ws_.run(args);
-    if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
-    return r;
-  }
+  BenchCommand() : CommandTest("pdflab-bench") {}
 
-
-  // A non-square reference, so a swapped width and height would show.
-  void make_reference(const std::string& name = "ref.pfm") const {
-    const ChildResult r = run({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp", "256",
-                             "--width", "12", "--height", "8", "--threads", "2", "--quiet", "--out", in_work(name)});
-    ASSERT_EQ(r.status, 0) << r.err;
-  }
+  void make_reference(const std::string& name = "ref.pfm") const { render_reference("mix:cosine=0.5,light=0.5", name); }
 
   std::vector<std::string> bench_args(const std::vector<std::string>& extra) const {
     std::vector<std::string> a = {"bench", "--scene", kBookScene, "--reference", in_work("ref.pfm"),
@@ -159,20 +146,6 @@ class BenchCommand : public ::testing::Test {
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   }
-
-  // Exit 2, one message containing `needle`, and the work folder as it was.
-  void expect_bad_input(const std::vector<std::string>& args, const std::string& needle) const {
-    const std::vector<std::string> before = work_entries();
-    const ChildResult r = run(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(needle), std::string::npos) << "message lacks '" << needle << "': " << r.err;
-    EXPECT_EQ(r.err.find("internal"), std::string::npos) << r.err;
-    EXPECT_EQ(work_entries(), before) << "bad input left files behind";
-  }
-
- private:
-  pdflab::testing::CommandWorkspace ws_{"pdflab-bench"};
 };
 
 TEST_F(BenchCommand, MissingReferenceIsBadInput) {

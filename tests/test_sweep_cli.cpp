@@ -3,7 +3,7 @@
 // weight with the documented columns, the same errors `pdflab bench` measures
 // for the same mixture and seed, one best weight inside its own interval, and
 // a plot with the best weight marked.
-#include "tests/support.h"
+#include "tests/command_test.h"
 
 #include <gtest/gtest.h>
 
@@ -59,37 +59,17 @@ double number(const std::map<std::string, std::string>& row, const std::string& 
   return std::strtod(it->second.c_str(), nullptr);
 }
 
-class SweepCommand : public ::testing::Test {
+class SweepCommand : public pdflab::testing::CommandTest {
  protected:
-  std::string in_work(const std::string& name) const { return ws_.in_work(name); }
-  std::vector<std::string> work_entries() const { return ws_.work_entries(); }
-  ChildResult run(const std::vector<std::string>& args) const {
-    const ChildResult r = ws_.run(args);
-    if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
-    return r;
-  }
-  void make_reference() const {
-    const ChildResult r = run({"render", "--scene", kBookScene, "--strategy", "nee-mis", "--spp", "256", "--width",
-                               "12", "--height", "8", "--threads", "2", "--quiet", "--out", in_work("ref.pfm")});
-    ASSERT_EQ(r.status, 0) << r.err;
-  }
+  SweepCommand() : CommandTest("pdflab-sweep") {}
+
+  void make_reference() const { render_reference("nee-mis"); }
   std::vector<std::string> sweep_args(const std::vector<std::string>& extra) const {
     std::vector<std::string> a = {"sweep", "--scene", kBookScene, "--reference", in_work("ref.pfm"), "--csv",
                                   in_work("out.csv"), "--plot", in_work("out.svg"), "--threads", "2", "--quiet"};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   }
-  void expect_bad_input(const std::vector<std::string>& args, const std::string& needle) const {
-    const std::vector<std::string> before = work_entries();
-    const ChildResult r = run(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_NE(r.err.find(needle), std::string::npos) << "message lacks '" << needle << "': " << r.err;
-    EXPECT_EQ(r.err.find("internal"), std::string::npos) << r.err;
-    EXPECT_EQ(work_entries(), before) << "bad input left files behind";
-  }
-
- private:
-  pdflab::testing::CommandWorkspace ws_{"pdflab-sweep"};
 };
 
 TEST_F(SweepCommand, BadRangesAreBadInput) {

@@ -35,6 +35,60 @@ std::string fmt(const char* f, double v) {
 constexpr const char* kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
                                     "#17becf", "#7f7f7f", "#bcbd22", "#000000", "#6b6ecf", "#e7ba52", "#843c39"};
 
+// The parts every plot shares: the document, its title, the grid lines with
+// their tick labels, the plot box, the axis labels and the legend beside it.
+struct Frame {
+  const PlotOptions& o;
+  double left, top, pw, ph;
+  std::string svg;
+  double legend_y;
+
+  Frame(const PlotOptions& options, double left_margin, double right_margin)
+      : o(options), left(left_margin), top(40), pw(o.width - left_margin - right_margin), ph(o.height - 40 - 60) {
+    svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
+          std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+    svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+           escape(o.title) + "</text>\n";
+    legend_y = top + 10;
+  }
+  void vertical_grid(double x, const std::string& label) {
+    svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
+           fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
+           label + "</text>\n";
+  }
+  void horizontal_grid(double y, const std::string& label) {
+    svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
+           "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" + label +
+           "</text>\n";
+  }
+  void box_and_labels() {
+    svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
+           "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"" + fmt("%.1f", o.height - 15.0) +
+           "\" text-anchor=\"middle\">" + escape(o.x_label) + "</text>\n";
+    svg += "<text transform=\"translate(20," + fmt("%.1f", top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
+           escape(o.y_label) + "</text>\n";
+  }
+  void legend(const std::string& colour, const std::string& label, bool dashed) {
+    svg += "<line x1=\"" + fmt("%.1f", left + pw + 15) + "\" y1=\"" + fmt("%.1f", legend_y) + "\" x2=\"" +
+           fmt("%.1f", left + pw + 40) + "\" y2=\"" + fmt("%.1f", legend_y) + "\" stroke=\"" + colour +
+           "\" stroke-width=\"2\"" + (dashed ? " stroke-dasharray=\"5,4\"" : "") + "/>\n";
+    svg += "<text x=\"" + fmt("%.1f", left + pw + 45) + "\" y=\"" + fmt("%.1f", legend_y + 4) + "\">" + escape(label) +
+           "</text>\n";
+    legend_y += 20;
+  }
+};
+
+// The legend sits right of the plot; long mixture names must fit inside the
+// picture (about 7 px a character at 12 px sans-serif).
+double right_margin(const std::vector<PlotSeries>& series, std::size_t longest) {
+  for (const auto& s : series) longest = std::max(longest, s.label.size());
+  return std::max(200.0, 60.0 + 7.0 * static_cast<double>(longest));
+}
+
 }  // namespace
 
 std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions& o) {
@@ -50,50 +104,17 @@ std::string loglog_svg(const std::vector<PlotSeries>& series, const PlotOptions&
   const double lx0 = std::floor(std::log10(x0)), lx1 = std::max(lx0 + 1.0, std::ceil(std::log10(x1)));
   const double ly0 = std::floor(std::log10(y0)), ly1 = std::max(ly0 + 1.0, std::ceil(std::log10(y1)));
 
-  // The legend sits right of the plot; long mixture names must fit inside the
-  // picture (about 7 px a character at 12 px sans-serif).
-  std::size_t longest = o.guide_label.size();
-  for (const auto& s : series) longest = std::max(longest, s.label.size());
-  const double left = 80, right = std::max(200.0, 60.0 + 7.0 * static_cast<double>(longest)), top = 40, bottom = 60;
-  const double pw = o.width - left - right, ph = o.height - top - bottom;
+  Frame f(o, 80, right_margin(series, o.guide_label.size()));
+  const double left = f.left, top = f.top, pw = f.pw, ph = f.ph;
   auto px = [&](double x) { return left + (std::log10(x) - lx0) / (lx1 - lx0) * pw; };
   auto py = [&](double y) { return top + (ly1 - std::log10(y)) / (ly1 - ly0) * ph; };
-
-  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
-                    std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
-         escape(o.title) + "</text>\n";
-  for (double d = lx0; d <= lx1 + 1e-9; d += 1.0) {
-    const double x = left + (d - lx0) / (lx1 - lx0) * pw;
-    svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
-           fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
-           tick_label(std::pow(10.0, d)) + "</text>\n";
-  }
-  for (double d = ly0; d <= ly1 + 1e-9; d += 1.0) {
-    const double y = top + (ly1 - d) / (ly1 - ly0) * ph;
-    svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
-           "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" +
-           tick_label(std::pow(10.0, d)) + "</text>\n";
-  }
-  svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
-         "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
-  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"" + fmt("%.1f", o.height - 15.0) +
-         "\" text-anchor=\"middle\">" + escape(o.x_label) + "</text>\n";
-  svg += "<text transform=\"translate(20," + fmt("%.1f", top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
-         escape(o.y_label) + "</text>\n";
-
-  double legend_y = top + 10;
-  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) {
-    svg += "<line x1=\"" + fmt("%.1f", left + pw + 15) + "\" y1=\"" + fmt("%.1f", legend_y) + "\" x2=\"" +
-           fmt("%.1f", left + pw + 40) + "\" y2=\"" + fmt("%.1f", legend_y) + "\" stroke=\"" + colour +
-           "\" stroke-width=\"2\"" + (dashed ? " stroke-dasharray=\"5,4\"" : "") + "/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left + pw + 45) + "\" y=\"" + fmt("%.1f", legend_y + 4) + "\">" + escape(label) +
-           "</text>\n";
-    legend_y += 20;
-  };
+  for (double d = lx0; d <= lx1 + 1e-9; d += 1.0)
+    f.vertical_grid(left + (d - lx0) / (lx1 - lx0) * pw, tick_label(std::pow(10.0, d)));
+  for (double d = ly0; d <= ly1 + 1e-9; d += 1.0)
+    f.horizontal_grid(top + (ly1 - d) / (ly1 - ly0) * ph, tick_label(std::pow(10.0, d)));
+  f.box_and_labels();
+  std::string& svg = f.svg;
+  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) { f.legend(colour, label, dashed); };
 
   for (std::size_t k = 0; k < series.size(); ++k) {
     const auto& s = series[k];
@@ -163,18 +184,11 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
   const double top_value = nice_ceiling(y1 * (1.0 + 1e-9));
   const double x0 = o.x_min, x1 = o.x_max > o.x_min ? o.x_max : o.x_min + 1.0;
 
-  std::size_t longest = o.marker_label.size();
-  for (const auto& s : series) longest = std::max(longest, s.label.size());
-  const double left = 90, right = std::max(200.0, 60.0 + 7.0 * static_cast<double>(longest)), top = 40, bottom = 60;
-  const double pw = o.width - left - right, ph = o.height - top - bottom;
+  Frame f(o, 90, right_margin(series, o.marker_label.size()));
+  const double left = f.left, top = f.top, pw = f.pw, ph = f.ph;
   auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * pw; };
   auto py = [&](double y) { return top + (1.0 - y / top_value) * ph; };
-
-  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
-                    std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
-         escape(o.title) + "</text>\n";
+  std::string& svg = f.svg;
   if (std::isfinite(o.marker_x)) {
     const double a = px(std::clamp(o.marker_lo, x0, x1)), b = px(std::clamp(o.marker_hi, x0, x1));
     svg += "<rect x=\"" + fmt("%.1f", std::min(a, b)) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" +
@@ -182,36 +196,11 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
   }
   // Ticks at 1, 2 or 5 times a power of ten, at most ten steps over the range.
   const double x_step = nice_ceiling((x1 - x0) / 10.0 * (1.0 - 1e-9));
-  for (double xv = std::ceil(x0 / x_step - 1e-9) * x_step; xv <= x1 + 1e-9 * x_step; xv += x_step) {
-    const double x = px(xv);
-    svg += "<line x1=\"" + fmt("%.1f", x) + "\" y1=\"" + fmt("%.1f", top) + "\" x2=\"" + fmt("%.1f", x) + "\" y2=\"" +
-           fmt("%.1f", top + ph) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", x) + "\" y=\"" + fmt("%.1f", top + ph + 18) + "\" text-anchor=\"middle\">" +
-           tick_label(xv) + "</text>\n";
-  }
-  for (int k = 0; k <= 5; ++k) {
-    const double yv = top_value * k / 5.0, y = py(yv);
-    svg += "<line x1=\"" + fmt("%.1f", left) + "\" y1=\"" + fmt("%.1f", y) + "\" x2=\"" + fmt("%.1f", left + pw) +
-           "\" y2=\"" + fmt("%.1f", y) + "\" stroke=\"#ddd\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left - 8) + "\" y=\"" + fmt("%.1f", y + 4) + "\" text-anchor=\"end\">" +
-           tick_label(yv) + "</text>\n";
-  }
-  svg += "<rect x=\"" + fmt("%.1f", left) + "\" y=\"" + fmt("%.1f", top) + "\" width=\"" + fmt("%.1f", pw) +
-         "\" height=\"" + fmt("%.1f", ph) + "\" fill=\"none\" stroke=\"#333\"/>\n";
-  svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"" + fmt("%.1f", o.height - 15.0) +
-         "\" text-anchor=\"middle\">" + escape(o.x_label) + "</text>\n";
-  svg += "<text transform=\"translate(20," + fmt("%.1f", top + ph / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
-         escape(o.y_label) + "</text>\n";
-
-  double legend_y = top + 10;
-  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) {
-    svg += "<line x1=\"" + fmt("%.1f", left + pw + 15) + "\" y1=\"" + fmt("%.1f", legend_y) + "\" x2=\"" +
-           fmt("%.1f", left + pw + 40) + "\" y2=\"" + fmt("%.1f", legend_y) + "\" stroke=\"" + colour +
-           "\" stroke-width=\"2\"" + (dashed ? " stroke-dasharray=\"5,4\"" : "") + "/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left + pw + 45) + "\" y=\"" + fmt("%.1f", legend_y + 4) + "\">" + escape(label) +
-           "</text>\n";
-    legend_y += 20;
-  };
+  for (double xv = std::ceil(x0 / x_step - 1e-9) * x_step; xv <= x1 + 1e-9 * x_step; xv += x_step)
+    f.vertical_grid(px(xv), tick_label(xv));
+  for (int k = 0; k <= 5; ++k) f.horizontal_grid(py(top_value * k / 5.0), tick_label(top_value * k / 5.0));
+  f.box_and_labels();
+  auto legend = [&](const std::string& colour, const std::string& label, bool dashed) { f.legend(colour, label, dashed); };
   for (std::size_t k = 0; k < series.size(); ++k) {
     const auto& s = series[k];
     const std::string colour = kColours[k % (sizeof kColours / sizeof kColours[0])];

@@ -2,10 +2,120 @@
 
 #include "renderer/integrator/integrator.h"
 
+#include "renderer/error.h"
+
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <thread>
 
 namespace pdflab {
+
+std::vector<std::pair<std::string, double>> mixture_terms(const Strategy& s) {
+  // The text, not the strategy's fields: nothing here depends on how a
+  // strategy stores its weights.
+  const std::string text = s.to_string();
+  if (text.rfind("mix:", 0) != 0) return {{text, 1.0}};
+  std::vector<std::pair<std::string, double>> terms;
+  std::stringstream ss(text.substr(4));
+  std::string term;
+  while (std::getline(ss, term, ',')) {
+    const std::size_t eq = term.find('=');
+    terms.emplace_back(term.substr(0, eq), std::stod(term.substr(eq + 1)));
+  }
+  return terms;
+}
+
+namespace {
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.erase(s.begin());
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.pop_back();
+  return s;
+}
+
+}  // namespace
+
+Strategy TechniquePair::at(double w) const {
+  char buf[64];
+  std::string text = "mix:";
+  std::snprintf(buf, sizeof buf, "%s=%.9g,%s=%.9g", a.c_str(), share * w, b.c_str(), share * (1.0 - w));
+  text += buf;
+  for (const auto& [name, weight] : rest) {
+    std::snprintf(buf, sizeof buf, ",%s=%.9g", name.c_str(), weight);
+    text += buf;
+  }
+  return with_roulette(Strategy::parse(text), roulette_depth);
+}
+
+MixtureFamily TechniquePair::mixture_family() const {
+  MixtureFamily m;
+  m.a = Strategy::parse(a);
+  m.b = Strategy::parse(b);
+  m.share = rest.empty() ? 1.0 : share;
+  if (!rest.empty()) {
+    std::string text = "mix:";
+    for (const auto& [name, weight] : rest) text += (text.size() > 4 ? "," : "") + name + "=" + std::to_string(weight);
+    m.rest = Strategy::parse(text);
+  }
+  return m;
+}
+
+double TechniquePair::weight_of(const Strategy& strategy) const {
+  if (strategy.nee_mis || strategy.roulette_depth != roulette_depth) return -1.0;
+  Strategy s = strategy;
+  s.roulette_depth = 0;  // the mixture's terms alone
+  double wa = 0.0, wb = 0.0;
+  std::vector<std::pair<std::string, double>> others;
+  for (const auto& [name, weight] : mixture_terms(s))
+    if (name == a) wa += weight;
+    else if (name == b) wb += weight;
+    else others.emplace_back(name, weight);
+  if (!(wa + wb > 0.0) || std::fabs(wa + wb - share) > 1e-6 || others.size() != rest.size()) return -1.0;
+  for (const auto& [name, weight] : others) {
+    const auto it = std::find_if(rest.begin(), rest.end(), [&](const auto& r) { return r.first == name; });
+    if (it == rest.end() || std::fabs(it->second - weight) > 1e-6) return -1.0;
+  }
+  return wa / (wa + wb);
+}
+
+TechniquePair parse_technique_pair(const std::string& vary, const std::string& base, int roulette_depth) {
+  const std::size_t comma = vary.find(',');
+  if (comma == std::string::npos || vary.find(',', comma + 1) != std::string::npos)
+    throw InputError("--vary '" + vary + "' is not two techniques A,B (for example cosine,light)");
+  TechniquePair f;
+  f.roulette_depth = roulette_depth;
+  for (std::string* name : {&f.a, &f.b}) {
+    *name = trimmed(name == &f.a ? vary.substr(0, comma) : vary.substr(comma + 1));
+    Strategy s;
+    try {
+      s = Strategy::parse(*name);
+    } catch (const InputError& e) {  // an unknown name: the message lists the known ones
+      throw InputError("--vary '" + vary + "': " + e.what());
+    }
+    if (s.nee_mis || s.to_string().rfind("mix:", 0) == 0)
+      throw InputError("--vary '" + vary + "': '" + *name + "' is not a mixture technique");
+    *name = s.to_string();  // canonical, as the base mixture's terms are written
+  }
+  if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
+  if (base.empty()) return f;
+  Strategy s = Strategy::parse(base);
+  if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
+  s.roulette_depth = 0;  // the mixture's terms alone
+  if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
+  double pair = 0.0;
+  for (const auto& [name, weight] : mixture_terms(s))
+    if (name == f.a || name == f.b)
+      pair += weight;
+    else
+      f.rest.emplace_back(name, weight);
+  if (!(pair > 0.0))
+    throw InputError("--strategy '" + base + "' gives " + f.a + " and " + f.b +
+                     " no weight: the sweep would hold them at zero");
+  f.share = pair;
+  return f;
+}
 
 WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& family, const Strategy& mixture,
                                     double w, const std::vector<double>& grid, const WeightPathOptions& o) {

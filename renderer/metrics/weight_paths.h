@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pdflab {
@@ -20,6 +21,31 @@ struct MixtureFamily {
   Strategy rest;       // the fixed techniques' mixture (unused when share is 1)
   double share = 1.0;  // the pair's total weight; the rest has 1 - share
 };
+
+// Two techniques A and B whose shares of one mixture vary, the others held at
+// their weights: the family a sweep, bench's prediction and the viewer's curve
+// walk along. w is A's share of the pair, whose total weight is `share`.
+struct TechniquePair {
+  std::string a, b;                                   // canonical technique names
+  double share = 1.0;                                 // the pair's total weight
+  std::vector<std::pair<std::string, double>> rest;  // the others, normalised weights
+  int roulette_depth = 0;                             // Strategy::roulette_depth of every member
+
+  Strategy at(double w) const;           // the mixture at A's share w
+  MixtureFamily mixture_family() const;  // the densities the predictor evaluates
+  // A's share of the pair in `s` when s is a member of this family (the same
+  // techniques, the others at the same weights); -1 otherwise.
+  double weight_of(const Strategy& s) const;
+};
+
+// "A,B" (a comma between two technique names) with an optional base mixture
+// whose other techniques keep their weights, and Russian roulette from
+// `roulette_depth` on (0: the base's own, if any). InputError naming `vary` or `base`.
+TechniquePair parse_technique_pair(const std::string& vary, const std::string& base = "", int roulette_depth = 0);
+
+// A strategy's canonical text as (technique, weight) pairs: "cosine" or
+// "mix:cosine=0.25,light=0.75", the weights normalised as the text gives them.
+std::vector<std::pair<std::string, double>> mixture_terms(const Strategy& s);
 
 struct WeightPathOptions {
   std::uint64_t seed = 2;
