@@ -7,11 +7,13 @@
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/metrics/svg_plot.h"
+#include "renderer/metrics/weight_paths.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -35,7 +37,56 @@ struct Result {
   double estimated_relmse = 0;  // the film's own prediction, for comparison with the measured relmse
   std::uint64_t dropped = 0;
   std::vector<Checkpoint> curve;
+  double weight = -1.0;     // with --predict: A's share of the pair; -1 outside the family
+  double predicted = -1.0;  // the efficiency predicted from the pilot's paths; -1: none
 };
+
+// Samples per pixel of the pilot's run replayed for the prediction (as sweep).
+constexpr std::uint32_t kPredictionSpp = 256;
+
+// --predict A,B: the family is the first strategy of the list that mixes both
+// (its other techniques keep their weights); the pilot is the member nearest
+// w = 0.5 inside the defensive floor. -1 when no member is inside the floor.
+struct Prediction {
+  TechniquePair pair;
+  int pilot = -1;
+  std::vector<double> weights;  // per strategy, -1 for a non-member
+};
+
+Prediction plan_prediction(const std::string& predict, const std::vector<Strategy>& strategies) {
+  Prediction p;
+  TechniquePair probe = parse_technique_pair(predict);
+  bool found = false;
+  for (const Strategy& s : strategies) {
+    double a = 0.0, b = 0.0;
+    Strategy terms_only = s;
+    terms_only.roulette_depth = 0;
+    for (const auto& [name, weight] : mixture_terms(terms_only)) {
+      if (name == probe.a) a += weight;
+      if (name == probe.b) b += weight;
+    }
+    if (!s.nee_mis && a > 0.0 && b > 0.0) {
+      p.pair = parse_technique_pair(predict, s.to_string());
+      found = true;
+      break;
+    }
+  }
+  if (!found) throw InputError("--predict '" + predict + "': no strategy in --strategies mixes " + probe.a + " and " + probe.b);
+  for (std::size_t i = 0; i < strategies.size(); ++i) {
+    const double w = p.pair.weight_of(strategies[i]);
+    p.weights.push_back(w);
+    if (w >= 0.0 && defended_weight(w) == w &&
+        (p.pilot < 0 || std::fabs(w - 0.5) < std::fabs(p.weights[static_cast<std::size_t>(p.pilot)] - 0.5)))
+      p.pilot = static_cast<int>(i);
+  }
+  if (p.pilot < 0) {
+    char range[64];
+    std::snprintf(range, sizeof range, "[%.2g, %.2g]", kDefensiveFloor, 1.0 - kDefensiveFloor);
+    throw InputError("--predict '" + predict + "': no mixture of " + p.pair.a + " and " + p.pair.b +
+                     " in --strategies gives " + p.pair.a + " a share inside " + range + " to predict from");
+  }
+  return p;
+}
 
 std::vector<Strategy> parse_strategy_list(const std::string& text, int roulette_depth) {
   std::vector<Strategy> out;
@@ -48,6 +99,14 @@ std::vector<Strategy> parse_strategy_list(const std::string& text, int roulette_
 }
 
 std::string csv_field(const std::string& s) { return "\"" + s + "\""; }
+
+// A figure that may be absent (negative): empty in the CSV.
+std::string optional_number(double v) {
+  if (!(v >= 0.0) || !std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
 
 void write_text(const std::string& path, const std::string& text) {
   write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
@@ -129,6 +188,7 @@ int run_bench(const BenchOptions& o) {
   auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
   const std::vector<Strategy> strategies = parse_strategy_list(o.strategies, o.roulette_depth);
   for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
+  const Prediction prediction = o.predict.empty() ? Prediction{} : plan_prediction(o.predict, strategies);
   const Reference reference = comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height},
                                                    strategies, {o.seed}, o.quiet);
 
@@ -146,6 +206,32 @@ int run_bench(const BenchOptions& o) {
     results.push_back(run_one(scene, strategies[i], o, reference, prefix, show_progress));
   }
   if (show_progress) std::fputc('\n', stderr);
+  double predicted_best = -1.0;
+  if (prediction.pilot >= 0 && results[static_cast<std::size_t>(prediction.pilot)].spp > 0) {
+    // Replays the pilot's first samples (same seed and indices: the very paths
+    // it drew) and predicts on a grid of 0.01 and on every member's weight.
+    const Result& pilot = results[static_cast<std::size_t>(prediction.pilot)];
+    const double w = prediction.weights[static_cast<std::size_t>(prediction.pilot)];
+    std::vector<double> grid = weight_grid(101);
+    for (double m : prediction.weights)
+      if (m >= 0.0) grid.push_back(m);
+    std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+    WeightPathOptions po;
+    po.seed = o.seed;
+    po.samples = std::min(pilot.spp, kPredictionSpp);
+    po.threads = o.threads;
+    const WeightPrediction p =
+        record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po)
+            .predict(reference.rgb, pilot.seconds / pilot.spp, kRelMseEpsilon);
+    predicted_best = p.best_weight();
+    for (std::size_t i = 0; i < results.size(); ++i)
+      if (prediction.weights[i] >= 0.0) {
+        results[i].weight = prediction.weights[i];
+        const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
+        results[i].predicted = p.efficiency[static_cast<std::size_t>(g)];
+      }
+  }
 
   // Every text is built before the first is written, so only an I/O failure
   // can leave one file without the others.
@@ -156,14 +242,14 @@ int run_bench(const BenchOptions& o) {
   // roulette_depth: where Russian roulette starts (0: off).
   std::string csv =
       "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased,relmse_raw,"
-      "relmse_ci,ref_share,roulette_depth\n";
+      "relmse_ci,ref_share,roulette_depth,weight,predicted_efficiency\n";
   char line[512];
   for (const Result& r : results) {
-    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g,%d\n", r.spp, r.seconds,
+    std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g,%d,", r.spp, r.seconds,
                   r.rmse, r.error.corrected, r.efficiency, r.samples_per_second,
                   static_cast<unsigned long long>(r.dropped), r.estimated_relmse, r.strategy.is_unbiased() ? 1 : 0,
                   r.error.raw, r.error.interval, r.error.reference_share(), r.strategy.roulette_depth);
-    csv += csv_field(r.strategy.to_string()) + line;
+    csv += csv_field(r.strategy.to_string()) + line + optional_number(r.weight) + "," + optional_number(r.predicted) + "\n";
   }
 
   std::string curves;
@@ -203,14 +289,19 @@ int run_bench(const BenchOptions& o) {
   if (!o.plot.empty()) write_text(o.plot, plot);
 
   // The table: efficiency relative to the first strategy says which PDF wins.
-  std::printf("%-36s %7s %8s %10s %10s %9s %10s %7s %10s %11s %8s %9s %8s\n", "strategy", "spp", "seconds", "rmse",
-              "relmse", "+-", "raw", "ref %", "est relmse", "efficiency", "vs first", "Msamp/s", "dropped");
+  const bool predicted = prediction.pilot >= 0;
+  std::printf("%-36s %7s %8s %10s %10s %9s %10s %7s %10s %11s %8s %9s %8s%s\n", "strategy", "spp", "seconds", "rmse",
+              "relmse", "+-", "raw", "ref %", "est relmse", "efficiency", "vs first", "Msamp/s", "dropped",
+              predicted ? "   predicted" : "");
   for (const Result& r : results) {
     const double ratio = results[0].efficiency > 0 ? r.efficiency / results[0].efficiency : 0.0;
-    std::printf("%-36s %7u %8.2f %10.4g %10.4g %9.2g %10.4g %6.1f%% %10.4g %11.4g %7.2fx %9.3f %8llu%s\n",
+    char guess[32] = "";
+    if (predicted && r.predicted >= 0.0) std::snprintf(guess, sizeof guess, " %11.4g", r.predicted);
+    else if (predicted) std::snprintf(guess, sizeof guess, " %11s", "-");
+    std::printf("%-36s %7u %8.2f %10.4g %10.4g %9.2g %10.4g %6.1f%% %10.4g %11.4g %7.2fx %9.3f %8llu%s%s\n",
                 r.strategy.to_string().c_str(), r.spp, r.seconds, r.rmse, r.error.corrected, r.error.interval,
                 r.error.raw, 100.0 * r.error.reference_share(), r.estimated_relmse, r.efficiency, ratio,
-                r.samples_per_second * 1e-6, static_cast<unsigned long long>(r.dropped),
+                r.samples_per_second * 1e-6, static_cast<unsigned long long>(r.dropped), guess,
                 r.strategy.is_unbiased() ? "" : "  (biased)");
   }
   std::printf("relMSE = mean (x - ref)^2 / (ref^2 + %.0e) %s, +- its 95%% interval; raw: uncorrected; ref %%: the "
@@ -218,6 +309,12 @@ int run_bench(const BenchOptions& o) {
               "own prediction, no reference\n",
               kRelMseEpsilon,
               reference.has_variance() ? "minus the reference's own noise" : "(the reference has no variance: uncorrected)");
+  if (predicted)
+    std::printf("predicted: efficiency of each mixture of %s and %s from the paths of %s (%s's share %.3g); predicted "
+                "best share of %s: %.3g\n",
+                prediction.pair.a.c_str(), prediction.pair.b.c_str(),
+                strategies[static_cast<std::size_t>(prediction.pilot)].to_string().c_str(), prediction.pair.a.c_str(),
+                prediction.weights[static_cast<std::size_t>(prediction.pilot)], prediction.pair.a.c_str(), predicted_best);
   return 0;
 }
 

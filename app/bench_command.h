@@ -21,6 +21,10 @@ struct BenchOptions {
   std::string csv;
   std::string plot;        // SVG, optional
   std::string curves;      // CSV of every checkpoint, optional
+  // "A,B": predict, from the paths of the strategy nearest w = 0.5 among those
+  // mixing A and B (A's share w of the pair, the others as in the first such
+  // strategy), the efficiency of every other such strategy. Optional.
+  std::string predict;
   // Not render's default (1): a reference rendered with the same seed shares
   // its first samples with the run, and the error would look too small.
   std::uint64_t seed = 2;

@@ -197,6 +197,8 @@ int main(int argc, char** argv) {
   bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
   bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
+  bench->add_option("--predict", bo.predict,
+                    "A,B: predict each mixture of A and B's efficiency from the paths of the one nearest 0.5");
   bench->add_option("--seed", bo.seed, "Random seed (default 2; use one the reference was not rendered with)")
       ->check(non_negative_integer());
   bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));

@@ -18,6 +18,7 @@ struct RunLimit {
   double seconds = 0.0;   // > 0: equal time (or)
   std::uint32_t spp = 0;  // > 0: equal samples
   int threads = 0;
+  std::uint32_t first_sample = 0;  // each pixel's first sample index (a run continuing another)
 };
 
 struct MeasuredRun {

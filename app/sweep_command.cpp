@@ -28,8 +28,6 @@ namespace pdflab {
 namespace {
 
 constexpr int kMaxWeights = 201;
-// Auto weight's passes use seeds this far apart from the sweep's.
-constexpr std::uint64_t kAutoSeedStride = 1000;
 
 std::string trim(std::string s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.erase(s.begin());
@@ -105,8 +103,9 @@ struct Run {
 
 Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                 const SweepOptions& o, const Reference& reference, const std::string& label,
-                bool show_progress, std::vector<float>* image = nullptr) {
-  const MeasuredRun run = render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads}, label, show_progress);
+                bool show_progress, std::vector<float>* image = nullptr, std::uint32_t first_sample = 0) {
+  const MeasuredRun run =
+      render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads, first_sample}, label, show_progress);
   Run r;
   r.spp = run.stats.spp;
   r.seconds = run.stats.seconds;
@@ -119,48 +118,58 @@ Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strat
   return r;
 }
 
-// Auto weight (weight_paths.h): the run is split into passes of 1/8, 1/8, 1/4
-// and 1/2 of the time (or spp); each pass renders at the weight the passes
-// before it predicted best, starting at 0.5, and the image is their
-// sample-weighted mean. Its time includes replaying paths for the prediction.
+// Auto weight (weight_paths.h): the run is split into AutoWeight's passes
+// (1/16, 1/16, 1/8, 1/4, 1/2 of the time or spp); each pass renders at the
+// weight the passes before it predicted best, starting at 0.5, and the image
+// is their sample-weighted mean. Its time includes replaying paths for the
+// prediction.
 struct AutoRun {
   Run run;
   std::vector<double> weights;  // per pass
+  double replay_seconds = 0.0;  // of run.seconds, the time spent predicting
 };
 
 AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePair& family, const MixtureFamily& mixtures,
                     std::uint64_t seed, const SweepOptions& o, const Reference& reference, const std::string& label,
                     bool show_progress) {
-  constexpr double kShare[4] = {0.125, 0.125, 0.25, 0.5};
-  // Few replayed samples and a coarse grid: the replay's time counts against auto weight.
-  constexpr std::uint32_t kReplaySpp = 4;
-  AutoWeight chooser(0.5, 21);
+  AutoWeight chooser;
   const std::size_t values = reference.rgb.size();
   std::vector<double> sum(values, 0.0);
   AutoRun out;
   double seconds = 0.0;
   std::uint32_t spp = 0;
-  for (int pass = 0; pass < 4; ++pass) {
+  for (int pass = 0; pass < AutoWeight::kPasses; ++pass) {
     const double w = chooser.weight();
     out.weights.push_back(w);
     SweepOptions slice = o;
-    slice.seconds = o.seconds * kShare[pass];
-    slice.spp = o.spp > 0 ? std::max<std::uint32_t>(1, static_cast<std::uint32_t>(o.spp * kShare[pass])) : 0;
-    const std::uint64_t pass_seed = seed + kAutoSeedStride * static_cast<std::uint64_t>(pass + 1);
+    slice.seconds = o.seconds * AutoWeight::pass_share(pass);
+    slice.spp = o.spp > 0 ? std::max<std::uint32_t>(1, static_cast<std::uint32_t>(o.spp * AutoWeight::pass_share(pass))) : 0;
+    // One seed, each pass continuing the sample indices where the last one
+    // stopped: together the passes draw the very pixel positions (one
+    // (0,2)-sequence per pixel) and random streams of a fixed-weight run of
+    // as many samples; only the weights differ.
+    const std::uint32_t first = spp;
     std::vector<float> image;
-    const Run r = render_once(scene, family.at(w), pass_seed, slice, reference, label, show_progress, &image);
+    const Run r = render_once(scene, family.at(w), seed, slice, reference, label, show_progress, &image, first);
     for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(image[i]) * r.spp;
     spp += r.spp;
     seconds += r.seconds;
-    if (pass == 3 || r.spp == 0) continue;
+    if (pass + 1 == AutoWeight::kPasses || r.spp == 0) continue;
+    // The prediction knows what a render knows: the passes so far (their mean
+    // image), not the reference.
     const auto start = std::chrono::steady_clock::now();
+    std::vector<float> so_far(values);
+    for (std::size_t i = 0; i < values; ++i) so_far[i] = static_cast<float>(sum[i] / spp);
     WeightPathOptions po;
-    po.seed = pass_seed;
-    po.samples = std::min(r.spp, kReplaySpp);
+    po.seed = seed;
+    po.first_sample = first;
+    po.samples = AutoWeight::replay_samples(r.spp);
     po.threads = o.threads;
     const WeightPredictor predictor = record_weight_paths(*scene, mixtures, family.at(w), w, chooser.grid(), po);
-    chooser.add_pass(predictor.predict(reference.rgb, r.seconds / r.spp, kRelMseEpsilon));
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    chooser.add_pass(predictor.predict(so_far, r.seconds / r.spp, kRelMseEpsilon));
+    const double replay = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    seconds += replay;
+    out.replay_seconds += replay;
   }
   std::vector<float> mean(values);
   for (std::size_t i = 0; i < values; ++i) mean[i] = spp > 0 ? static_cast<float>(sum[i] / spp) : 0.0f;
@@ -263,9 +272,6 @@ int run_sweep(const SweepOptions& o) {
   for (int k = 0; k < o.seeds; ++k) seeds.push_back(o.seed + static_cast<std::uint64_t>(k));
   std::vector<Strategy> strategies;
   for (const Row& r : rows) strategies.push_back(r.strategy);
-  if (o.auto_weight)
-    for (int k = 0; k < o.seeds; ++k)
-      for (std::uint64_t pass = 1; pass <= 4; ++pass) seeds.push_back(seeds[static_cast<std::size_t>(k)] + kAutoSeedStride * pass);
   const Reference reference =
       comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height}, strategies, seeds, o.quiet);
 
@@ -287,18 +293,24 @@ int run_sweep(const SweepOptions& o) {
 
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const bool show_progress = !o.quiet && tty;
+  // Seed by seed, every weight (and auto weight) in turn: on a machine whose
+  // speed drifts, each weight's runs are spread over the whole sweep, so the
+  // drift falls on all weights alike instead of on a few.
   const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
   std::size_t done_runs = 0;
-  for (Row& r : rows) {
-    std::vector<double> seconds, rel, eff, sps;
-    for (int k = 0; k < o.seeds; ++k) {
+  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), eff(rows.size()), sps(rows.size());
+  std::vector<double> auto_eff, auto_rel, auto_sec;
+  std::vector<std::vector<double>> auto_weights;
+  for (int k = 0; k < o.seeds; ++k) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      Row& r = rows[i];
       char label[96];
       std::snprintf(label, sizeof label, "[%zu/%zu] %s=%.3g seed %d/%d", ++done_runs, total, family.a.c_str(), r.weight,
                     k + 1, o.seeds);
       const Run run = render_once(scene, r.strategy, seeds[static_cast<std::size_t>(k)], o, reference, label,
                                   show_progress);
       if (k == 0) r.spp = run.spp;
-      if (&r == &rows[static_cast<std::size_t>(std::max(pilot, 0))] && pilot >= 0 && run.spp > 0) {
+      if (static_cast<int>(i) == pilot && run.spp > 0) {
         WeightPathOptions po;
         po.seed = seeds[static_cast<std::size_t>(k)];
         po.samples = std::min(run.spp, kPredictionSpp);
@@ -308,40 +320,35 @@ int run_sweep(const SweepOptions& o) {
           map_png = best_weight_png(predictor, reference.rgb, scene->camera.width, scene->camera.height);
         predictions.push_back(predictor.predict(reference.rgb, run.seconds / run.spp, kRelMseEpsilon));
       }
-      seconds.push_back(run.seconds);
-      rel.push_back(run.relmse);
-      eff.push_back(run.efficiency);
-      sps.push_back(run.samples_per_second);
+      seconds[i].push_back(run.seconds);
+      rel[i].push_back(run.relmse);
+      eff[i].push_back(run.efficiency);
+      sps[i].push_back(run.samples_per_second);
       if (!o.quiet && !tty)
         std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, run.spp, run.seconds,
                      run.relmse, run.efficiency);
     }
-    r.seconds = interval(seconds);
-    r.relmse = interval(rel);
-    r.efficiency = interval(eff);
-    r.samples_per_second = interval(sps);
+    if (!o.auto_weight) continue;
+    char label[64];
+    std::snprintf(label, sizeof label, "[auto] seed %d/%d", k + 1, o.seeds);
+    const AutoRun a = render_auto(scene, family, mixture_family, seeds[static_cast<std::size_t>(k)], o, reference,
+                                  label, show_progress);
+    auto_eff.push_back(a.run.efficiency);
+    auto_rel.push_back(a.run.relmse);
+    auto_sec.push_back(a.run.seconds);
+    auto_weights.push_back(a.weights);
+    if (!o.quiet && !tty)
+      std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting), relMSE %.4g, efficiency %.4g\n", label, a.run.spp,
+                   a.run.seconds, a.replay_seconds, a.run.relmse, a.run.efficiency);
   }
-  Interval auto_efficiency, auto_relmse, auto_seconds;
-  std::vector<std::vector<double>> auto_weights;
-  if (o.auto_weight) {
-    std::vector<double> eff, rel, sec;
-    for (int k = 0; k < o.seeds; ++k) {
-      char label[64];
-      std::snprintf(label, sizeof label, "[auto] seed %d/%d", k + 1, o.seeds);
-      const AutoRun a = render_auto(scene, family, mixture_family, seeds[static_cast<std::size_t>(k)], o, reference,
-                                    label, show_progress);
-      eff.push_back(a.run.efficiency);
-      rel.push_back(a.run.relmse);
-      sec.push_back(a.run.seconds);
-      auto_weights.push_back(a.weights);
-      if (!o.quiet && !tty)
-        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, a.run.spp, a.run.seconds,
-                     a.run.relmse, a.run.efficiency);
-    }
-    auto_efficiency = interval(eff);
-    auto_relmse = interval(rel);
-    auto_seconds = interval(sec);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i].seconds = interval(seconds[i]);
+    rows[i].relmse = interval(rel[i]);
+    rows[i].efficiency = interval(eff[i]);
+    rows[i].samples_per_second = interval(sps[i]);
   }
+  const Interval auto_efficiency = interval(auto_eff), auto_relmse = interval(auto_rel),
+                 auto_seconds = interval(auto_sec);
   if (show_progress) std::fputc('\n', stderr);
 
   // The best weight among the unbiased ones (a biased mixture's error stops
@@ -465,10 +472,10 @@ int run_sweep(const SweepOptions& o) {
               "vs best", "predicted", "Msamp/s");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
-    char eff[64];
-    std::snprintf(eff, sizeof eff, "%.4g +- %.2g", r.efficiency.mean, r.efficiency.half);
+    char eff_text[64];
+    std::snprintf(eff_text, sizeof eff_text, "%.4g +- %.2g", r.efficiency.mean, r.efficiency.half);
     std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %11.4g %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(),
-                r.spp, r.relmse.mean, eff, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
+                r.spp, r.relmse.mean, eff_text, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
                 r.predicted.mean, r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
                 static_cast<int>(i) == best ? "  <- best" : "");
   }

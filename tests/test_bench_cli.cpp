@@ -269,6 +269,41 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
   EXPECT_EQ(work_entries(), (std::vector<std::string>{"curves.csv", "out.csv", "out.svg", "ref.pfm"}));
 }
 
+// --predict: every mixture of the pair gets its weight and the efficiency
+// predicted from the pilot's paths (the mixture nearest 0.5). At the pilot's
+// own weight the prediction is the pilot's measured efficiency in expectation
+// (the same samples, the same time per pass); the others are positive.
+TEST_F(BenchCommand, PredictsTheMixturesEfficiencyFromThePilotsPaths) {
+  make_reference();
+  const ChildResult r = run(bench_args({"--strategies",
+                                        "cosine;mix:cosine=0.3,light=0.7;mix:cosine=0.5,light=0.5;"
+                                        "mix:cosine=0.8,light=0.2;uniform-sphere",
+                                        "--spp", "256", "--predict", "cosine,light"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> header;
+  const auto rows = parse_csv(slurp(work() / "out.csv"), header);
+  ASSERT_EQ(rows.size(), 5u);
+  ASSERT_EQ(header.back(), "predicted_efficiency");
+  const double expected_weight[4] = {1.0, 0.3, 0.5, 0.8};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(std::stod(rows[static_cast<std::size_t>(i)].at("weight")), expected_weight[i], 1e-9) << i;
+    EXPECT_GT(std::stod(rows[static_cast<std::size_t>(i)].at("predicted_efficiency")), 0.0) << i;
+  }
+  // uniform-sphere is no mixture of cosine and light: no weight, no prediction.
+  EXPECT_EQ(rows[4].at("weight"), "");
+  EXPECT_EQ(rows[4].at("predicted_efficiency"), "");
+  const double measured = std::stod(rows[2].at("efficiency")), predicted = std::stod(rows[2].at("predicted_efficiency"));
+  EXPECT_NEAR(predicted / measured, 1.0, 0.3) << "measured " << measured << ", predicted " << predicted;
+  EXPECT_NE(r.out.find("predicted best share of cosine"), std::string::npos) << r.out;
+
+  expect_bad_input(bench_args({"--strategies", "cosine", "--spp", "2", "--predict", "cosine"}), "not two techniques");
+  expect_bad_input(bench_args({"--strategies", "cosine;mix:cosine=0.5,light=0.5", "--spp", "2", "--predict",
+                               "cosine,uniform-sphere"}),
+                   "no strategy in --strategies mixes cosine and uniform-sphere");
+  expect_bad_input(bench_args({"--strategies", "mix:cosine=0.99,light=0.01", "--spp", "2", "--predict", "cosine,light"}),
+                   "to predict from");
+}
+
 TEST_F(BenchCommand, EqualTimeRunsForAboutTheGivenTime) {
   make_reference();
   const ChildResult r = run(bench_args({"--strategies", "cosine", "--seconds", "0.3"}));

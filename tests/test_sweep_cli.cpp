@@ -242,7 +242,7 @@ TEST_F(SweepCommand, AutoWeightAddsARow) {
   ASSERT_EQ(rows.size(), 4u);
   const std::string history = rows[3].at("strategy");
   ASSERT_EQ(history.rfind("auto:0.5>", 0), 0u) << history;
-  EXPECT_EQ(std::count(history.begin(), history.end(), '>'), 3) << "four passes";
+  EXPECT_EQ(std::count(history.begin(), history.end(), '>'), 4) << "five passes";
   EXPECT_GT(number(rows[3], "efficiency"), 0.0);
   EXPECT_NE(r.out.find("auto weight: efficiency"), std::string::npos) << r.out;
 }

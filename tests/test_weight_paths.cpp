@@ -127,11 +127,13 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
   o.threads = 2;
   o.film = &automatic;
   o.samples = 512;
+  // As sweep --auto does: one seed, each pass continuing the sample indices.
+  o.seed = 100;
   for (int pass = 0; pass < 4; ++pass) {
     const double w = chooser.weight();
     char text[64];
     std::snprintf(text, sizeof text, "mix:cosine=%.9g,light=%.9g", w, 1.0 - w);
-    o.seed = 100 + static_cast<std::uint64_t>(pass);
+    o.first_sample = static_cast<std::uint32_t>(pass) * o.samples;
     const WeightPredictor p = record_weight_paths(scene, family, Strategy::parse(text), w, chooser.grid(), o);
     // The pass's own mean as mu: what a render knows (no reference).
     std::vector<float> mean;
@@ -149,6 +151,7 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
   Film fixed(8, 8);
   o.film = &fixed;
   o.samples = 2048;
+  o.first_sample = 0;
   o.seed = 7;
   (void)record_weight_paths(scene, family, Strategy::parse("mix:cosine=0.5,light=0.5"), 0.5, {0.5}, o);
 

@@ -163,13 +163,24 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   return std::move(parts[0]);
 }
 
+double AutoWeight::pass_share(int pass) {
+  static constexpr double kShare[kPasses] = {1.0 / 16, 1.0 / 16, 1.0 / 8, 1.0 / 4, 1.0 / 2};
+  return pass >= 0 && pass < kPasses ? kShare[pass] : 0.0;
+}
+
+std::uint32_t AutoWeight::replay_samples(std::uint32_t pass_spp) {
+  return std::min(pass_spp, std::clamp<std::uint32_t>(pass_spp / 32, 1, 8));
+}
+
 AutoWeight::AutoWeight(double first, int grid_points)
     : grid_(weight_grid(grid_points)), sum_(grid_.size(), 0.0), history_{defended_weight(first)} {}
 
 void AutoWeight::add_pass(const WeightPrediction& prediction) {
   if (prediction.efficiency.size() != grid_.size()) return;
   ++passes_;
-  for (std::size_t g = 0; g < grid_.size(); ++g) sum_[g] += prediction.efficiency[g];
+  // Each pass's curve counts by its paths: a pass that replayed more has the less noisy curve.
+  const double paths = static_cast<double>(prediction.paths);
+  for (std::size_t g = 0; g < grid_.size(); ++g) sum_[g] += paths * prediction.efficiency[g];
   std::size_t best = 0;
   for (std::size_t g = 1; g < grid_.size(); ++g)
     if (sum_[g] > sum_[best]) best = g;

@@ -66,12 +66,25 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
 // is their sample-weighted sum. (A weight chosen from a pass's own samples
 // would correlate the weight with those samples' noise, and the sum would no
 // longer be unbiased.)
+//
+// The schedule: a run of kPasses passes taking 1/16, 1/16, 1/8, 1/4 and 1/2 of
+// its time (or samples), the first at `first`. The first pass is short because
+// its weight is a guess; after each pass but the last a few of its samples per
+// pixel are replayed for the prediction (replay_samples: about 1/32 of the
+// pass, 1 to 8: predicting costs several per cent of a short run, less of a
+// long one), and the next weight is the best of the passes' predicted curves
+// so far, each counted by its number of paths.
 class AutoWeight {
  public:
-  explicit AutoWeight(double first = 0.5, int grid_points = 101);
+  static constexpr int kPasses = 5;
+  static double pass_share(int pass);  // of the run, for pass 0 .. kPasses - 1
+  static std::uint32_t replay_samples(std::uint32_t pass_spp);
+
+  explicit AutoWeight(double first = 0.5, int grid_points = 21);
   double weight() const { return history_.back(); }  // for the next pass
   // A finished pass's prediction (on grid()): the next weight is the best of
-  // the mean predicted efficiency so far, kept inside the defensive floor.
+  // the path-weighted mean predicted efficiency so far, kept inside the
+  // defensive floor.
   void add_pass(const WeightPrediction& prediction);
   const std::vector<double>& grid() const { return grid_; }
   const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next

@@ -104,8 +104,11 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
       const double mu2 = mean_square_rgb ? static_cast<double>((*mean_square_rgb)[i]) : mu * mu;
       // relMSE's denominator is r^2 + eps with r the pixel's value; for a block, its mean.
       const double denominator = mu * mu + epsilon;
+      // Not clipped per cell: with a few paths a cell's moment often falls
+      // below mu^2, and clipping each would bias the sum upwards by an amount
+      // that depends on w'. The sum over cells is clipped below.
       for (std::size_t g = 0; g < grid_size; ++g)
-        p.relative_variance[g] += std::max(0.0, second_moment(cell, g, c) - mu2) / denominator;
+        p.relative_variance[g] += (second_moment(cell, g, c) - mu2) / denominator;
       ++terms;
     }
   }
@@ -116,7 +119,7 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
   const double cost_here = plain_cost_sum_ / static_cast<double>(paths_);
   double best = -1.0;
   for (std::size_t g = 0; g < grid_size; ++g) {
-    p.relative_variance[g] /= static_cast<double>(terms);
+    p.relative_variance[g] = std::max(0.0, p.relative_variance[g] / static_cast<double>(terms));
     p.cost[g] = offset_sum_[g] > 0.0 ? cost_sum_[g] / offset_sum_[g] : std::numeric_limits<double>::infinity();
     const double time_scale =
         seconds_per_sample > 0.0 && cost_here + cost_offset > 0.0
