@@ -110,9 +110,15 @@ int main(int argc, char** argv) {
                  "Continue a film file (from render --film-out or the viewer's Ctrl+S) with its scene and settings");
   float view_ui_scale = 1.0f;
   bool view_presentation = false;
+  bool view_auto_weight = false;
+  std::string view_mode;
   app.add_option("--ui-scale", view_ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
       ->check(CLI::Range(0.5f, 4.0f));
   app.add_flag("--presentation", view_presentation, "Start in presentation mode: full screen, no panel (F11 leaves)");
+  app.add_flag("--auto-weight", view_auto_weight,
+               "Start with auto weight: a two-technique mixture's w moves between passes to the predicted best");
+  app.add_option("--view", view_mode,
+                 "Start in a view mode: image, heatmap, difference, drops, best-weight, technique-share");
   app.add_option("--reference", view_reference,
                  "Reference image (PFM) for live error figures in the viewer (default: the cached one, if any)");
   double view_make_seconds = 0.0;
@@ -270,6 +276,8 @@ int main(int argc, char** argv) {
     }
     vo.ui_scale = view_ui_scale;
     vo.presentation = view_presentation;
+    vo.auto_weight = view_auto_weight;
+    vo.view = view_mode;
     vo.make_reference_seconds = view_make_seconds;
     return pdflab::run_viewer(vo);
 #else

@@ -3,6 +3,7 @@
 #include "app/assets.h"
 #include "app/teaching.h"
 #include "app/viewer_references.h"
+#include "app/viewer_weights.h"
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
@@ -96,6 +97,17 @@ struct Viewer::Impl {
   std::unique_ptr<RenderSession> session;
   std::unique_ptr<TeachingViews> teaching;
   std::unique_ptr<ViewerReferences> references;
+  std::unique_ptr<WeightLab> weight_lab;
+  // Auto weight: the chooser of this run, the spp of the next pass boundary,
+  // the weights so far, and where the current weight's samples begin.
+  struct AutoRun {
+    bool on = false;
+    AutoWeight chooser;
+    std::uint32_t next_spp = 16;
+    std::vector<float> history;
+    std::uint64_t generation = ~std::uint64_t{0};
+    std::uint32_t spp_before = 0;  // in the film from earlier weights
+  } auto_run;
   bool main_rests_for_reference = false;  // paused while a reference takes every thread
 
   std::shared_ptr<const Scene> base_scene;  // as loaded
@@ -203,6 +215,8 @@ struct Viewer::Impl {
   void after_reference_changed();
   void service_references();
   void handle_measure_requests(const ui::MeasureRequests& r);
+  void service_weights();
+  void service_auto_weight();
 
   // The steps of a frame, in order (see Viewer::frame).
   struct FrameLayout;
@@ -240,6 +254,8 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   if (!(o.ui_scale >= ui::kMinUiScale && o.ui_scale <= ui::kMaxUiScale))
     throw InputError("--ui-scale " + std::to_string(o.ui_scale) + " is outside 0.5..4");
   settings.ui_scale = o.ui_scale;
+  settings.auto_weight = o.auto_weight;
+  if (!o.view.empty()) settings.measure.view_mode = ui::parse_view_mode(o.view);
   if (o.make_reference_seconds > 0.0) settings.measure.make_seconds = static_cast<float>(o.make_reference_seconds);
   if (!o.reference.empty()) {
     measure.set_reference(ui::load_reference(o.reference));  // a bad file is bad input, before any window
@@ -260,6 +276,7 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   teaching = std::make_unique<TeachingViews>(so.on_image);
   teaching->set_shared_reference(&measure.reference);
   references = std::make_unique<ViewerReferences>();
+  weight_lab = std::make_unique<WeightLab>();
   if (!apply_render_settings()) throw InputError(status.settings_error);
   if (!o.resume.empty()) continue_film(o.resume);
   if (o.presentation && !cli_mode()) set_presentation(true);
@@ -471,6 +488,7 @@ void Viewer::Impl::rebuild_fonts() {
 void Viewer::Impl::close() {
   teaching.reset();
   references.reset();  // a reference in the making stops with the viewer
+  weight_lab.reset();  // waits for a replay in flight
   session.reset();  // workers stop first: nothing renders into a closing viewer
   if (save_job.valid()) save_job.wait();
   display.reset();
@@ -906,6 +924,8 @@ void Viewer::Impl::fill_status() {
   status.frame_ms = report.work_ms;
   status.measure = &measure;
   status.split = teaching->split_state();
+  status.weights = weight_lab->curve();
+  if (auto_run.on) status.weights.history = auto_run.history;
 }
 
 void Viewer::Impl::load_reference(const std::string& path) {
@@ -961,6 +981,80 @@ struct Viewer::Impl::FrameLayout {
   ui::ImageRect area_rect;     // the image area, ImGui coordinates
 };
 
+// The prediction beside the w slider and the two weight views (viewer_weights.h).
+void Viewer::Impl::service_weights() {
+  const std::array<int, 2> pair = ui::two_technique_pair(applied.sampling, panel.w_pair);
+  const bool mixture = applied.sampling.mixture && !applied.sampling.nee_mis;
+  WeightLab::Input in;
+  in.scene = render_scene;
+  in.strategy = applied.sampling.strategy();
+  in.seed = applied.seed;
+  in.spp_before = auto_run.on ? auto_run.spp_before : 0;
+  in.first_sample = film_first_sample + in.spp_before;
+  in.generation = session->generation();
+  in.a = mixture ? pair[0] : -1;
+  in.b = mixture ? pair[1] : -1;
+  in.image = &measure.published;
+  if (weight_lab->update(in)) {
+    measure.set_weight_maps(weight_lab->maps());
+    settle_frames = std::max(settle_frames, 1);
+  }
+}
+
+// Auto weight: at 16, 32, 64, ... spp the weight moves to the best that the
+// passes so far predict, and the accumulation goes on (the film continues,
+// with the next sample indices). Each pass's weight is fixed before the pass
+// starts and depends only on earlier passes' samples, so every pass is an
+// unbiased render and so is the film that sums them (docs/measuring.md).
+void Viewer::Impl::service_auto_weight() {
+  const std::array<int, 2> pair = ui::two_technique_pair(applied.sampling, panel.w_pair);
+  const bool usable = settings.auto_weight && applied.sampling.mixture && !applied.sampling.nee_mis && pair[0] >= 0;
+  if (!usable) {
+    auto_run.on = false;
+    return;
+  }
+  const int a = pair[0], b = pair[1];
+  const float sum = applied.sampling.weights[a] + applied.sampling.weights[b];
+  const double current = sum > 0.0f ? applied.sampling.weights[a] / sum : 0.5;
+  const std::uint64_t generation = session->generation();
+  if (!auto_run.on || generation != auto_run.generation) {
+    // Turned on, or something else changed and restarted the render: a new run.
+    auto_run = AutoRun();
+    auto_run.on = true;
+    auto_run.chooser = AutoWeight(current);
+    auto_run.history = {static_cast<float>(auto_run.chooser.weight())};
+    auto_run.generation = generation;
+  }
+  const std::optional<WeightPrediction>& p = weight_lab->prediction();
+  if (!p || weight_lab->generation() != generation || image_info.generation != generation || image_info.preview ||
+      image_info.spp < auto_run.next_spp)
+    return;
+  // At the stop (or past it) there is no next pass to choose a weight for.
+  if (settings.stop_spp != 0 && image_info.spp >= settings.stop_spp) return;
+  auto_run.chooser.add_pass(*p);
+  while (auto_run.next_spp <= image_info.spp) auto_run.next_spp *= 2;
+  const double w = auto_run.chooser.weight();
+  auto_run.history.push_back(static_cast<float>(w));
+  if (std::fabs(w - current) < 1e-6) return;
+  // Continue the film at the new weight.
+  session->set_paused(true);
+  Film film = session->copy_film();
+  const SessionStats st = session->stats();
+  RenderSettings rs = session->settings();
+  settings.sampling.weights[a] = static_cast<float>(w);
+  settings.sampling.weights[b] = static_cast<float>(1.0 - w);
+  rs.strategy = settings.sampling.strategy();
+  try {
+    session->resume(rs, FilmStart{std::move(film), st.spp, st.dropped});
+  } catch (const InputError& e) {
+    status.settings_error = e.what();
+  }
+  session->set_paused(settings.paused || main_rests_for_reference);
+  applied.sampling = settings.sampling;
+  auto_run.spp_before = st.spp;
+  auto_run.generation = session->generation();
+}
+
 void Viewer::Impl::handle_input() {
   // Last frame's quick releases first (see open_window), then the new events.
   pressed_this_frame.clear();
@@ -973,6 +1067,8 @@ void Viewer::Impl::handle_input() {
 
 void Viewer::Impl::service_background() {
   pull_image();
+  service_auto_weight();
+  service_weights();
   service_references();
   teaching->update(*session, settings.paused);
   service_screenshots();

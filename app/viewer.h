@@ -19,6 +19,8 @@ struct ViewerOptions {
   std::string reference;  // PFM to measure the error against (empty: none)
   float ui_scale = 1.0f;  // panels and text, times the screen's own scale (0.5..4)
   bool presentation = false;  // start full screen without the panel
+  bool auto_weight = false;   // start with auto weight on (a two-technique mixture)
+  std::string view;           // start in this view mode (its label or short name; empty: the image)
   double make_reference_seconds = 0.0;  // the Make reference time's first value (0: 30 s)
   // A film file (film_file.h) to continue: its strategy, seed, size and depth
   // are applied and its accumulation goes on (scene and strategy must match it).

@@ -177,3 +177,46 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
 }
 
 }  // namespace
+
+namespace {
+
+// "Which technique found the light": the shares of every path with light sum
+// to the luminance it carried, and cosine's share of the light found through a
+// diffuse vertex is larger at w = 0.95 than at w = 0.05.
+TEST(WeightPaths, TechniqueSharesSplitWhatThePathsCarried) {
+  const Scene scene = small_box(8);
+  const MixtureFamily family = cosine_light();
+  double share_of_cosine[2] = {0.0, 0.0};
+  int k = 0;
+  for (double w : {0.05, 0.95}) {
+    Film film(8, 8);
+    std::vector<double> share;
+    WeightPathOptions o;
+    o.threads = 2;
+    o.samples = 64;
+    o.film = &film;
+    o.technique_share = &share;
+    char text[64];
+    std::snprintf(text, sizeof text, "mix:cosine=%.9g,light=%.9g", w, 1.0 - w);
+    (void)record_weight_paths(scene, family, Strategy::parse(text), w, {w}, o);
+    ASSERT_EQ(share.size(), 64u * kShareKinds);
+    double carried = 0.0, shared = 0.0, by_cosine = 0.0, found = 0.0;
+    for (std::size_t p = 0; p < 64; ++p) {
+      double m[3];
+      film.mean(p, m);
+      carried += (0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2]) * 64.0;  // film means times the sample count
+      for (int kind = 0; kind < kShareKinds; ++kind) shared += share[p * kShareKinds + static_cast<std::size_t>(kind)];
+      by_cosine += share[p * kShareKinds + kShareA];
+      found += share[p * kShareKinds + kShareA] + share[p * kShareKinds + kShareB];
+      EXPECT_EQ(share[p * kShareKinds + kShareRest], 0.0) << "no third technique";
+    }
+    EXPECT_NEAR(shared, carried, 1e-3 * carried);
+    ASSERT_GT(found, 0.0);
+    share_of_cosine[k++] = by_cosine / found;
+  }
+  // In expectation cosine's share is the integral of f/p_w * w a/p_w' weight:
+  // w a / (w a + (1 - w) b) grows with w at every direction, so its share does.
+  EXPECT_LT(share_of_cosine[0], share_of_cosine[1]);
+}
+
+}  // namespace

@@ -103,8 +103,8 @@ std::vector<LegendTick> legend_ticks(const ColourScale& scale) {
     ticks.push_back({1.0, tick_label(scale.hi)});
   } else if (scale.diverging) {
     for (double f : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
-      std::string label = tick_label(f * scale.hi);
-      if (f > 0.0) label = "+" + label;
+      std::string label = tick_label(f * scale.hi + scale.label_offset);
+      if (f > 0.0 && scale.label_offset == 0.0) label = "+" + label;
       ticks.push_back({scale.position(f * scale.hi), label});
     }
   } else {

@@ -30,6 +30,7 @@ struct ColourScale {
   bool logarithmic = false;
   bool diverging = false;  // symmetric: -hi..hi
   double lo = 0.0, hi = 1.0;
+  double label_offset = 0.0;  // diverging: the legend labels v + label_offset (a scale about 0.5)
   std::string title;
   double position(double v) const;  // 0..1 along the colour bar
   Colour colour(double v) const;

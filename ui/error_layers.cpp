@@ -1,5 +1,6 @@
 #include "ui/error_layers.h"
 
+#include "renderer/error.h"
 #include "renderer/integrator/integrator.h"
 #include "renderer/math.h"
 #include "renderer/metrics/metrics.h"
@@ -19,9 +20,20 @@ const char* view_mode_label(ViewMode mode) {
     case ViewMode::RelativeError: return "relative standard error";
     case ViewMode::Difference: return "difference to reference";
     case ViewMode::Drops: return "dropped samples";
+    case ViewMode::BestWeight: return "best weight (predicted)";
+    case ViewMode::TechniqueShare: return "which technique found the light";
     case ViewMode::Count: break;
   }
   return "?";
+}
+
+ViewMode parse_view_mode(const std::string& name) {
+  static constexpr const char* kNames[kViewModeCount] = {"image",       "heatmap",    "difference",
+                                                        "drops",       "best-weight", "technique-share"};
+  for (int i = 0; i < kViewModeCount; ++i)
+    if (name == kNames[i]) return static_cast<ViewMode>(i);
+  throw InputError("--view '" + name +
+                   "' is not a view mode (image, heatmap, difference, drops, best-weight, technique-share)");
 }
 
 ViewMode next_view_mode(ViewMode mode) {
@@ -217,8 +229,62 @@ ColourScale error_scale(ViewMode mode, const LayerOptions& options, const std::v
   return s;
 }
 
+ColourScale best_weight_scale(const WeightMaps& maps) {
+  ColourScale s;
+  s.diverging = true;
+  s.hi = 0.5;
+  s.lo = -0.5;
+  s.label_offset = 0.5;
+  s.title = "predicted best weight of " + maps.a + " (0: all " + maps.b + ", 1: all " + maps.a + ")";
+  return s;
+}
+
+ColourScale technique_share_scale(const WeightMaps& maps) {
+  ColourScale s;
+  s.lo = 0.0;
+  s.hi = 1.0;
+  s.title = "share of the light found by " + maps.a + "'s directions (0: all by " + maps.b + ")";
+  return s;
+}
+
+namespace {
+
+// The weight views: from the viewer's prediction, not from the published image.
+bool build_weight_layer(ViewMode mode, const WeightMaps* maps, ViewLayer& out, std::string& why) {
+  if (!maps || maps->a.empty()) {
+    why = maps && !maps->why.empty() ? maps->why : "render a mixture of two techniques";
+    return false;
+  }
+  const std::size_t pixels = static_cast<std::size_t>(maps->width) * static_cast<std::size_t>(maps->height);
+  const int block = std::max(1, maps->block), blocks_x = (maps->width + block - 1) / block;
+  const std::size_t cells = static_cast<std::size_t>(blocks_x * ((maps->height + block - 1) / block));
+  if (maps->share_a.size() != pixels || maps->best_weight.size() != cells || pixels == 0) {
+    why = maps->why.empty() ? "waiting for the prediction" : maps->why;
+    return false;
+  }
+  out.width = maps->width;
+  out.height = maps->height;
+  out.rgba.assign(4 * pixels, 0);
+  out.drop_pixels = {};
+  out.scale = mode == ViewMode::BestWeight ? best_weight_scale(*maps) : technique_share_scale(*maps);
+  for (int y = 0; y < maps->height; ++y)
+    for (int x = 0; x < maps->width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(maps->width) + static_cast<std::size_t>(x);
+      const float v = mode == ViewMode::BestWeight
+                          ? maps->best_weight[static_cast<std::size_t>((y / block) * blocks_x + x / block)]
+                          : maps->share_a[p];
+      // Nothing to say there: dark grey, so it does not read as a value.
+      if (v < 0.0f) put(out.rgba, p, {0.2f, 0.2f, 0.2f}, 255);
+      else put(out.rgba, p, out.scale.colour(mode == ViewMode::BestWeight ? v - 0.5 : v), 255);
+    }
+  return true;
+}
+
+}  // namespace
+
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why, const LayerOptions* given) {
+                      std::string& why, const LayerOptions* given, const WeightMaps* maps) {
+  if (mode == ViewMode::BestWeight || mode == ViewMode::TechniqueShare) return build_weight_layer(mode, maps, out, why);
   const LayerOptions options = given ? *given
                                      : (mode == ViewMode::Difference ? default_difference_options()
                                                                      : default_heat_map_options());

@@ -12,10 +12,13 @@
 
 namespace pdflab::ui {
 
-enum class ViewMode : std::uint8_t { Image, RelativeError, Difference, Drops, Count };
+enum class ViewMode : std::uint8_t { Image, RelativeError, Difference, Drops, BestWeight, TechniqueShare, Count };
 inline constexpr int kViewModeCount = static_cast<int>(ViewMode::Count);
 const char* view_mode_label(ViewMode mode);
 ViewMode next_view_mode(ViewMode mode);
+// A view mode by its short name (image, heatmap, difference, drops,
+// best-weight, technique-share); InputError naming them otherwise.
+ViewMode parse_view_mode(const std::string& name);
 
 // The per-pixel error a false-colour view shows, chosen as in tev: the signed
 // error, its absolute value or square, and those relative to the value (over
@@ -76,7 +79,26 @@ struct ViewLayer {
   ColourScale scale;  // for the colour bar (unused for Drops)
   std::array<std::uint64_t, 4> drop_pixels{};  // Drops: pixels per reason (+ several, last)
 };
+// The mixture-weight views' data (app/viewer_weights.h predicts them): per
+// cell of block x block pixels the predicted best weight of technique `a`
+// (its share of the pair; negative: w does not matter there), and per pixel
+// the share of the light its paths found through `a`'s directions (negative:
+// no light found).
+struct WeightMaps {
+  std::string a, b;  // the pair's techniques; empty: no maps
+  std::string why;   // when there are none: why
+  int width = 0, height = 0, block = 1;
+  std::vector<float> best_weight;  // ceil(width / block) x ceil(height / block)
+  std::vector<float> share_a;      // width x height
+  std::uint64_t paths = 0;
+};
+// The best-weight view's scale: diverging about 0.5, 0 (all b) blue, 1 (all a) red.
+ColourScale best_weight_scale(const WeightMaps& maps);
+// The technique-share view's: sequential, 0 (all found by b) to 1 (all by a).
+ColourScale technique_share_scale(const WeightMaps& maps);
+
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why, const LayerOptions* options = nullptr);  // null: the mode's defaults
+                      std::string& why, const LayerOptions* options = nullptr,  // null: the mode's defaults
+                      const WeightMaps* maps = nullptr);
 
 }  // namespace pdflab::ui

@@ -104,7 +104,7 @@ bool MeasureState::refresh_layer(const MeasureSettings& settings) {
   layer_mode = mode;
   layer_options = options;
   layer_why.clear();
-  layer_ok = build_view_layer(mode, published, &reference, layer, layer_why, &options);
+  layer_ok = build_view_layer(mode, published, &reference, layer, layer_why, &options, &weight_maps);
   return layer_ok;
 }
 

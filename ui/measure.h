@@ -115,7 +115,14 @@ struct MeasureState {
   bool layer_ok = false;        // `layer` shows `layer_mode` for `published`
   std::string layer_why;        // why not, when the mode is not Image
   ViewLayer layer;
+  WeightMaps weight_maps;       // set by the viewer's weight prediction
 
+  // New weight maps: the layer follows.
+  void set_weight_maps(WeightMaps maps) {
+    weight_maps = std::move(maps);
+    layer_ok = false;
+    layer_why.clear();
+  }
   // A newly published image: figures, and a convergence point when it shows
   // the generation now rendering (`label` is that generation's strategy).
   void on_image(std::uint64_t current_generation, const std::string& label);

@@ -151,7 +151,23 @@ void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, c
       const LayerOptions& o = m.layer_options;
       ImGui::TextColored(kDim, "%s", m.layer.scale.title.c_str());
       draw_colour_bar(m.layer.scale, width);
-      ImGui::TextColored(kDim, "%s", o.range.automatic ? "range: auto (1st to 99th percentile)" : "range: as set in the panel");
+      if (mode == ViewMode::BestWeight)
+        ImGui::TextColored(kDim,
+                           "Per %dx%d block, the weight of least predicted second moment (relative to the pixel, as "
+                           "relMSE weighs it), from %llu replayed paths. Red wants %s, blue %s; grey: w does not "
+                           "matter there.",
+                           m.weight_maps.block, m.weight_maps.block,
+                           static_cast<unsigned long long>(m.weight_maps.paths), m.weight_maps.a.c_str(),
+                           m.weight_maps.b.c_str());
+      else if (mode == ViewMode::TechniqueShare)
+        ImGui::TextColored(kDim,
+                           "Per %dx%d block, the share of the estimate whose light-reaching direction %s drew "
+                           "(each path split by the techniques' parts of the mixture pdf there). Bright: %s found "
+                           "it; dark: %s; grey: no light found yet, or lights seen directly.",
+                           m.weight_maps.block, m.weight_maps.block, m.weight_maps.a.c_str(),
+                           m.weight_maps.a.c_str(), m.weight_maps.b.c_str());
+      else
+        ImGui::TextColored(kDim, "%s", o.range.automatic ? "range: auto (1st to 99th percentile)" : "range: as set in the panel");
       if (mode == ViewMode::RelativeError && o.metric == ErrorMetric::Relative)
         ImGui::TextColored(kDim, "mean %.4f; per pixel: standard error of the mean / mean", m.figures.mean_relative_standard_error);
       else if (mode == ViewMode::Difference && o.metric == ErrorMetric::Signed)

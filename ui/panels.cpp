@@ -9,6 +9,7 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -32,6 +33,72 @@ void stat_cell(const char* label, const char* fmt, auto... args) {
   ImGui::TextColored(kDim, "%s", label);
   ImGui::TableNextColumn();
   ImGui::Text(fmt, args...);
+}
+
+// Beside the w slider: the efficiency predicted at every w from the paths
+// drawn so far, the predicted best marked, a button that moves the slider
+// there, auto weight and its history, and why the sampling weight keeps away
+// from 0 and 1 while predicting.
+void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int a, int b) {
+  SamplingSettings& s = settings.sampling;
+  const std::string name_a(technique_name(static_cast<Technique>(a))), name_b(technique_name(static_cast<Technique>(b)));
+  if (!c.active) {
+    ImGui::TextColored(kDim, "Predicted efficiency: %s", c.why.c_str());
+  } else {
+    ImGui::TextColored(kDim, "Predicted efficiency against w (%llu paths)", static_cast<unsigned long long>(c.paths));
+    const float width = ImGui::GetContentRegionAvail().x, height = ImGui::GetFontSize() * 5.0f;
+    const ImVec2 p0 = ImGui::GetCursorScreenPos();
+    ImGui::PlotLines("##predicted", c.relative_efficiency.data(), static_cast<int>(c.relative_efficiency.size()), 0,
+                     nullptr, 0.0f, 1.05f, ImVec2(width, height));
+    if (ImGui::IsItemHovered()) {
+      const float t = std::clamp((ImGui::GetIO().MousePos.x - p0.x) / width, 0.0f, 1.0f);
+      const std::size_t i = static_cast<std::size_t>(std::lround(t * static_cast<float>(c.weight.size() - 1)));
+      ImGui::SetTooltip("w = %.2f: %.0f%% of the best", c.weight[i], 100.0f * c.relative_efficiency[i]);
+    }
+    // The predicted best (amber) and the weight the paths came from (white).
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const auto mark = [&](double w, ImU32 colour, float thickness) {
+      const float x = p0.x + static_cast<float>(w) * width;
+      dl->AddLine(ImVec2(x, p0.y), ImVec2(x, p0.y + height), colour, thickness);
+    };
+    if (c.sampling >= 0.0) mark(c.sampling, IM_COL32(230, 230, 230, 200), 1.0f);
+    if (c.best >= 0.0) mark(c.best, IM_COL32(255, 190, 60, 255), 2.0f);
+    ImGui::TextColored(kAmber, "predicted best w = %.2f", c.best);
+    ImGui::SameLine();
+    if (ImGui::Button("Use the best weight") && c.best >= 0.0) {
+      s.weights[a] = static_cast<float>(c.best);
+      s.weights[b] = 1.0f - static_cast<float>(c.best);
+    }
+  }
+  ImGui::Checkbox("Auto weight", &settings.auto_weight);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Between passes (at 16, 32, 64, ... spp) w moves to the best the passes so far predict;\n"
+                      "each pass's weight is fixed before it starts, so the accumulated image stays unbiased.");
+  if (!c.history.empty()) {
+    ImGui::SameLine();
+    std::string h;
+    for (std::size_t i = c.history.size() > 6 ? c.history.size() - 6 : 0; i < c.history.size(); ++i) {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%s%.2f", h.empty() ? "" : " > ", c.history[i]);
+      h += buf;
+    }
+    ImGui::TextColored(kDim, "w: %s", h.c_str());
+    ImGui::PlotLines("##history", c.history.data(), static_cast<int>(c.history.size()), 0, nullptr, 0.0f, 1.0f,
+                     ImVec2(ImGui::GetContentRegionAvail().x, ImGui::GetFontSize() * 2.5f));
+  }
+  if (ImGui::TreeNode("Why is w kept inside [0.05, 0.95] while predicting?")) {
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextColored(kDim,
+                       "The curve reweights each path drawn at w by the ratio of its densities, p_w / p_w', to say "
+                       "what it would have cost at w'. That ratio is at most max(w'/w, (1-w')/(1-w)): bounded "
+                       "while w stays away from 0 and 1, but as w nears 0 (or 1) directions that only %s (or %s) "
+                       "draws are almost never seen, and the few that are carry huge ratios, so the prediction "
+                       "at the far end becomes noise. At w = 0 or 1 it cannot see them at all. So the prediction "
+                       "waits outside this floor, and auto weight never goes past it.",
+                       name_a.c_str(), name_b.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::TreePop();
+  }
 }
 
 void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
@@ -100,6 +167,7 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
         s.weights[b] = 1.0f - w;
       }
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
+      draw_weight_curve(settings, status.weights, a, b);
     }
     const auto norm = s.normalised();
     ImGui::TextColored(kDim, "weight per technique         fraction");

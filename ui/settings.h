@@ -78,6 +78,9 @@ struct ViewerSettings {
   // Non-zero: render at exactly this size instead of the scene's times
   // resolution_scale (set to match a reference image).
   int width_override = 0, height_override = 0;
+  // Auto weight: between passes the viewer moves the w slider to the weight
+  // the passes so far predict best, and the accumulation goes on.
+  bool auto_weight = false;
 };
 
 inline constexpr std::array<float, 5> kResolutionScales = {0.25f, 0.5f, 1.0f, 1.5f, 2.0f};
@@ -104,6 +107,17 @@ struct Notice {
   double shown_at = 0.0;  // seconds, on the viewer's clock
 };
 
+// The live prediction beside the w slider (app/viewer_weights.h).
+struct WeightCurveStatus {
+  bool active = false;     // a curve is shown (else `why`)
+  std::string why;         // why there is no curve yet
+  std::vector<float> weight, relative_efficiency;  // the grid; efficiency over its best
+  double best = -1.0;      // the predicted best weight (A's share)
+  double sampling = -1.0;  // the weight the paths were drawn at
+  std::uint64_t paths = 0;
+  std::vector<float> history;  // auto weight: each pass's weight, oldest first
+};
+
 // Read-only facts the panels show.
 struct UiStatus {
   SessionStats stats;
@@ -126,6 +140,7 @@ struct UiStatus {
   double frame_ms = 0.0;
   const MeasureState* measure = nullptr;  // the viewer's; null in tests without one
   const SplitState* split = nullptr;      // while the split screen is on: its two sides
+  WeightCurveStatus weights;
 };
 
 // Text-field buffers and other panel-local state that is not a setting.

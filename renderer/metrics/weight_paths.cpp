@@ -127,10 +127,13 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   const float rest_weight = static_cast<float>(1.0 - family.share);
   const int width = scene.camera.width, height = scene.camera.height;
   const WeightFamily weights{family.share};
+  if (o.technique_share) o.technique_share->resize(static_cast<std::size_t>(width * height) * kShareKinds, 0.0);
 
   int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads = std::min(threads, height);
-  std::vector<WeightPredictor> parts(static_cast<std::size_t>(threads), WeightPredictor(width * height, grid, w, weights));
+  const int block = std::max(1, o.block), blocks_x = (width + block - 1) / block;
+  std::vector<WeightPredictor> parts(static_cast<std::size_t>(threads),
+                                     WeightPredictor(block_cells(width, height, block), grid, w, weights));
   const SampleSeed seed(o.seed);
   auto work = [&](int part) {
     WeightPredictor& predictor = parts[static_cast<std::size_t>(part)];
@@ -151,8 +154,25 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
             vertices.push_back(m);
           }
           if (o.film) o.film->add(static_cast<std::size_t>(y * width + x), radiance);  // pixels of disjoint rows
+          if (o.technique_share) {
+            const double carried = 0.2126 * radiance.x + 0.7152 * radiance.y + 0.0722 * radiance.z;
+            double* share = &(*o.technique_share)[static_cast<std::size_t>(y * width + x) * kShareKinds];
+            if (carried > 0.0 && std::isfinite(carried)) {
+              if (vertices.empty()) {
+                share[kShareDirect] += carried;
+              } else {
+                const MixtureVertex& last = vertices.back();
+                const double p = weights.pdf(last, w);
+                if (p > 0.0) {
+                  share[kShareA] += carried * family.share * w * static_cast<double>(last.a) / p;
+                  share[kShareB] += carried * family.share * (1.0 - w) * static_cast<double>(last.b) / p;
+                  share[kShareRest] += carried * static_cast<double>(last.rest) / p;
+                }
+              }
+            }
+          }
           const float rgb[3] = {radiance.x, radiance.y, radiance.z};
-          predictor.add_path(y * width + x, rgb, vertices, static_cast<double>(record.segments));
+          predictor.add_path((y / block) * blocks_x + x / block, rgb, vertices, static_cast<double>(record.segments));
         }
   };
   std::vector<std::thread> pool;

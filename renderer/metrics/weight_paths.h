@@ -52,11 +52,32 @@ struct WeightPathOptions {
   std::uint32_t first_sample = 0, samples = 64;  // per pixel: sample indices first .. first + samples - 1
   int threads = 0;                               // <= 0: hardware threads
   Film* film = nullptr;  // when given (at the scene's size), the traced samples are added to it
+  // When given: per pixel, kShareKinds sums of the luminance the traced paths
+  // carried (see TechniqueShare), added to what is there.
+  std::vector<double>* technique_share = nullptr;
+  // The predictor's cells: block x block pixels each (the right and bottom
+  // ones may be cut), row by row; 1: one cell per pixel.
+  int block = 1;
 };
+
+// How many cells of `block` pixels a side cover a width x height image.
+inline int block_cells(int width, int height, int block) {
+  return ((width + block - 1) / block) * ((height + block - 1) / block);
+}
+
+// "Which technique found the light": a path's estimate is carried by the
+// direction its last diffuse vertex drew (lights do not scatter, so that
+// direction, through any specular bounces, reached the emitter). Its share
+// per technique is that technique's part of the mixture density there,
+// w_i p_i / p_w: the probability that it was the one drawing this direction
+// (the expected split of "which one drew it", with less noise than the draw
+// itself). Paths that see a light with no diffuse vertex are their own kind.
+enum TechniqueShare : int { kShareA = 0, kShareB = 1, kShareRest = 2, kShareDirect = 3, kShareKinds = 4 };
 
 // Traces `samples` per pixel of `scene` (prepared, at its camera size) with
 // `mixture`, the family's member at weight `w` — exactly the paths a render
-// with that seed draws — into a predictor over `grid` with one cell per pixel.
+// with that seed draws — into a predictor over `grid` with one cell per pixel
+// (or per block, options.block).
 WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& family, const Strategy& mixture,
                                     double w, const std::vector<double>& grid, const WeightPathOptions& options);
 

@@ -537,3 +537,44 @@ TEST(NoiseSummary, MatchesTheSeparateMetrics) {
   EXPECT_DOUBLE_EQ(n.mean_relative_standard_error, mean_relative_standard_error(film));
   EXPECT_NEAR(n.estimated_relmse, estimated_relmse(film), 1e-15);
 }
+
+namespace {
+
+using namespace pdflab::ui;
+
+// The weight views: the best-weight scale runs 0..1 about 0.5 (blue all b, red
+// all a), a cell without a best weight is grey, a bad --view name is refused.
+TEST(WeightViews, BestWeightLegendRunsFromZeroToOneAndGreyMeansNone) {
+  WeightMaps maps;
+  maps.a = "cosine";
+  maps.b = "light";
+  maps.width = 4;
+  maps.height = 2;
+  maps.block = 2;
+  maps.best_weight = {0.0f, 1.0f};  // left block all light, right block all cosine
+  maps.share_a = {0.0f, 0.0f, 1.0f, -1.0f, 0.0f, 0.0f, 1.0f, 1.0f};
+  const ColourScale s = best_weight_scale(maps);
+  std::vector<std::string> labels;
+  for (const LegendTick& t : legend_ticks(s)) labels.push_back(t.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"0", "0.25", "0.5", "0.75", "1"}));
+  ViewLayer layer;
+  std::string why;
+  ASSERT_TRUE(build_view_layer(ViewMode::BestWeight, {}, nullptr, layer, why, nullptr, &maps)) << why;
+  ASSERT_EQ(layer.rgba.size(), 4u * 8u);
+  // Pixel (0,0) is in the all-light block: blue beats red; pixel (3,1) all cosine: red beats blue.
+  EXPECT_GT(layer.rgba[2], layer.rgba[0]);
+  EXPECT_GT(layer.rgba[(1 * 4 + 3) * 4 + 0], layer.rgba[(1 * 4 + 3) * 4 + 2]);
+  ASSERT_TRUE(build_view_layer(ViewMode::TechniqueShare, {}, nullptr, layer, why, nullptr, &maps)) << why;
+  // No light found (-1): the same grey in every channel.
+  const std::uint8_t* grey = &layer.rgba[3 * 4];
+  EXPECT_EQ(grey[0], grey[1]);
+  EXPECT_EQ(grey[1], grey[2]);
+  WeightMaps none;
+  EXPECT_FALSE(build_view_layer(ViewMode::BestWeight, {}, nullptr, layer, why, nullptr, &none));
+  EXPECT_NE(why.find("two techniques"), std::string::npos) << why;
+  EXPECT_EQ(parse_view_mode("technique-share"), ViewMode::TechniqueShare);
+  EXPECT_EQ(parse_view_mode("best-weight"), ViewMode::BestWeight);
+  EXPECT_THROW(parse_view_mode("sideways"), pdflab::InputError);
+}
+
+}  // namespace
