@@ -2,7 +2,7 @@
 // each class of bad input exits 2 with one message naming the problem and
 // writes nothing; a small render writes the image, the stats JSON and a summary.
 #include "renderer/film/image_io.h"
-#include "tests/support.h"
+#include "tests/command_test.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -34,16 +34,9 @@ using testing::slurp;
 // Each test gets an empty working folder (the child's cwd and where outputs
 // go) and a separate folder for the captured streams, so that "nothing was
 // written" can be checked by listing the working folder.
-class RenderCommand : public ::testing::Test {
+class RenderCommand : public testing::CommandTest {
  protected:
-  fs::path work() const { return ws_.work(); }
-  std::string in_work(const std::string& name) const { return ws_.in_work(name); }
-  std::vector<std::string> work_entries() const { return ws_.work_entries(); }
-  ChildResult run(const std::vector<std::string>& args) const {
-    const ChildResult r = ws_.run(args);
-    if (!r.started) ADD_FAILURE() << "could not start " << PDFLAB_BINARY;
-    return r;
-  }
+  RenderCommand() : CommandTest("pdflab-cli") {}
 
 
   // A render command line that is valid except for what `overrides` changes.
@@ -83,8 +76,6 @@ class RenderCommand : public ::testing::Test {
     EXPECT_EQ(r.out, "") << "bad input printed a result";
     EXPECT_TRUE(work_entries().empty()) << "files were written: " << ::testing::PrintToString(work_entries());
   }
-
-  testing::CommandWorkspace ws_{"pdflab-cli"};
 };
 
 TEST_F(RenderCommand, ValidBaseCommandSucceeds) {

@@ -12,7 +12,6 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
-stddev() { identify -format "%[fx:standard_deviation]" "$1"; }
 
 echo "== a reference at the scene's size, and one at another size"
 "$pdflab" render --scene "$scene" --strategy cosine --spp 64 --out "$art/reference.pfm" --quiet

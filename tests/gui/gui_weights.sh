@@ -15,7 +15,6 @@ shift
 pdflab=$1 scene=$2 art=$3
 rm -rf "$art"
 mkdir -p "$art"
-stddev() { identify -format "%[fx:standard_deviation]" "$1"; }
 
 echo "== a bad --view is bad input: status 2, no window"
 set +e

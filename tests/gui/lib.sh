@@ -82,6 +82,8 @@ shot() {
   import -window "$wid" "$art/$1.png"
   [ -z "${2:-}" ] || convert "$art/$1.png" -crop "$2" +repage "$art/$1.png"
 }
+# stddev IMAGE: its standard deviation, 0..1 (0: one flat colour).
+stddev() { identify -format "%[fx:standard_deviation]" "$1"; }
 # rmse A B: the root-mean-square difference of two images, 0..1.
 rmse() { (compare -metric RMSE "$1" "$2" null: 2>&1 || true) | sed -n 's/.*(\(.*\)).*/\1/p'; }
 # changed A B [FLOOR] / same A B [CEILING]: two captures differ by more than
