@@ -36,6 +36,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
   std::stringstream ss(text);
   std::string part;
   while (std::getline(ss, part, sep)) parts.push_back(part);
+  if (!text.empty() && text.back() == sep) parts.emplace_back();  // a last field left empty
   return parts;
 }
 
@@ -274,11 +275,16 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
 // own weight the prediction is the pilot's measured efficiency in expectation
 // (the same samples, the same time per pass); the others are positive.
 TEST_F(BenchCommand, PredictsTheMixturesEfficiencyFromThePilotsPaths) {
-  make_reference();
+  // A reference far less noisy than the runs: with one as noisy as a run, the
+  // measured relMSE (corrected for the reference's noise) is itself mostly noise.
+  const ChildResult ref = run({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp",
+                               "16384", "--width", "12", "--height", "8", "--threads", "2", "--quiet", "--out",
+                               in_work("ref.pfm")});
+  ASSERT_EQ(ref.status, 0) << ref.err;
   const ChildResult r = run(bench_args({"--strategies",
                                         "cosine;mix:cosine=0.3,light=0.7;mix:cosine=0.5,light=0.5;"
                                         "mix:cosine=0.8,light=0.2;uniform-sphere",
-                                        "--spp", "256", "--predict", "cosine,light"}));
+                                        "--spp", "128", "--predict", "cosine,light"}));
   ASSERT_EQ(r.status, 0) << r.err;
   std::vector<std::string> header;
   const auto rows = parse_csv(slurp(work() / "out.csv"), header);
@@ -293,7 +299,7 @@ TEST_F(BenchCommand, PredictsTheMixturesEfficiencyFromThePilotsPaths) {
   EXPECT_EQ(rows[4].at("weight"), "");
   EXPECT_EQ(rows[4].at("predicted_efficiency"), "");
   const double measured = std::stod(rows[2].at("efficiency")), predicted = std::stod(rows[2].at("predicted_efficiency"));
-  EXPECT_NEAR(predicted / measured, 1.0, 0.3) << "measured " << measured << ", predicted " << predicted;
+  EXPECT_NEAR(predicted / measured, 1.0, 0.4) << "measured " << measured << ", predicted " << predicted;
   EXPECT_NE(r.out.find("predicted best share of cosine"), std::string::npos) << r.out;
 
   expect_bad_input(bench_args({"--strategies", "cosine", "--spp", "2", "--predict", "cosine"}), "not two techniques");

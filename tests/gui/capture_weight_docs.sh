@@ -16,7 +16,8 @@ scene=$root/assets/scenes/cornell_book.json
 start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
 sleep "$seconds"
 # The Sampling section: the w slider, the curve, the button, auto weight.
-convert <(import -window "$wid" png:-) -crop "400x290+$((WIDTH - 400))+0" +repage "$root/docs/view_weight_curve.png"
+import -window "$wid" "$root/docs/view_weight_curve.png"
+convert "$root/docs/view_weight_curve.png" -crop "400x290+$((WIDTH - 400))+0" +repage "$root/docs/view_weight_curve.png"
 echo "wrote docs/view_weight_curve.png"
 for _ in 1 2 3 4; do send_key v; sleep 0.3; done
 sleep 2
