@@ -105,7 +105,13 @@ void WeightLab::take(Result r) {
   curve_.relative_efficiency.clear();
   const double top = p.best >= 0 ? p.efficiency[static_cast<std::size_t>(p.best)] : 0.0;
   for (double e : p.efficiency) curve_.relative_efficiency.push_back(top > 0.0 ? static_cast<float>(e / top) : 0.0f);
-  curve_.best = p.best_weight();
+  // The best inside the floor: at w = 0 or 1 a technique may be biased alone
+  // (light sampling misses indirect light), which no path's ratio can show.
+  double best_efficiency = 0.0;
+  curve_.best = -1.0;
+  for (std::size_t g = 0; g < p.weight.size(); ++g)
+    if (defended_weight(p.weight[g]) == p.weight[g] && p.efficiency[g] > best_efficiency)
+      best_efficiency = p.efficiency[g], curve_.best = p.weight[g];
   curve_.sampling = w_;
   curve_.paths = p.paths;
   maps_.width = r.width;
