@@ -73,10 +73,14 @@ bool all_zero(const Strategy& s) {
 
 void glfw_error(int code, const char* message) { std::fprintf(stderr, "pdflab: GLFW error %d: %s\n", code, message); }
 
-// The screenshot folder: $PDFLAB_SCREENSHOT_DIR, else ./screenshots.
+// The screenshot folder: $PDFLAB_SCREENSHOT_DIR, else ./screenshots, shown in
+// the panel as an absolute path so that a user knows where the files go.
 std::string default_screenshot_dir() {
-  if (const char* env = std::getenv("PDFLAB_SCREENSHOT_DIR"); env && *env) return env;
-  return "screenshots";
+  const char* env = std::getenv("PDFLAB_SCREENSHOT_DIR");
+  const std::filesystem::path dir = env && *env ? env : "screenshots";
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(dir, ec);
+  return (ec ? dir : absolute).string();
 }
 
 double thread_cpu_ms() {
