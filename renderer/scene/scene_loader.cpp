@@ -358,12 +358,17 @@ Scene load_scene_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(printable("cannot read scene '" + path + "': " + std::strerror(errno)));
   std::string text;
+  // A regular file's size is known: one allocation. A device or a pipe grows
+  // the text chunk by chunk, and is refused before it passes the limit.
+  if (const auto size = std::filesystem::file_size(path, ec); !ec && size <= kMaxSceneBytes)
+    text.reserve(static_cast<std::size_t>(size));
   char chunk[1 << 16];
   while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-    text.append(chunk, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxSceneBytes)
+    const auto n = static_cast<std::size_t>(in.gcount());
+    if (text.size() + n > kMaxSceneBytes)
       throw InputError(printable("cannot read scene '" + path + "': larger than " +
                                  std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?"));
+    text.append(chunk, n);
   }
   if (in.bad()) throw InputError(printable("cannot read scene '" + path + "': read error"));
   return load_scene_text(text, path);
