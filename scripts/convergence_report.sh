@@ -12,7 +12,7 @@
 # measures their speeds first, so the reference's own noise stays a few per cent
 # of the best row's error whatever the machine's speed. Its time is about
 # 7 scenes x (REF_FACTOR x BENCH_SECONDS x (fastest strategy / reference strategy)
-# + 11 strategies x (SEEDS + 1/2) x BENCH_SECONDS), plus set-up:
+# + 11 strategies x (SEEDS + 1) x BENCH_SECONDS), plus set-up:
 #   bash scripts/convergence_report.sh     # defaults: about an hour on 2 cores
 #   SIZE=100 BENCH_SECONDS=1 bash scripts/convergence_report.sh   # about 20 minutes
 #   SCENES="cornell_book small_light" bash scripts/convergence_report.sh
@@ -85,14 +85,14 @@ else
 start=$(date +%s)
 for scene in "${SCENES[@]}"; do
   file=assets/scenes/$scene.json
-  # Calibration: half the run time for every strategy, no reference;
+  # Calibration: the run time for every strategy, against a rough reference;
   # the fastest one's samples per pixel per second sets the reference's size.
   echo "== $scene: calibrating the strategies' speeds" >&2
   # (bench needs a reference to compare with: a rough one does for timing)
-  half=$(awk -v b="$BENCH_SECONDS" 'BEGIN { print b / 2 }')
-  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --seconds "$half" \
+  calibration_seconds=$BENCH_SECONDS
+  "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --seconds "$calibration_seconds" \
     --threads "$THREADS" --cache-dir "$work/calibration" --out "$work/$scene.calibration.pfm" --quiet >&2
-  "$PDFLAB" bench --scene "$file" --strategies "$strategy_list" --seconds "$half" \
+  "$PDFLAB" bench --scene "$file" --strategies "$strategy_list" --seconds "$calibration_seconds" \
     --reference "$work/$scene.calibration.pfm" --threads "$THREADS" --quiet --csv "$work/$scene.calibration.csv" >&2
   ref_spp=$(awk -v f="$REF_FACTOR" -v b="$BENCH_SECONDS" '
     NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
@@ -166,7 +166,7 @@ SPLIT_ROW='
 
 # The per-scene figures, one line per strategy (in the order run), tab-separated:
 # strategy unbiased spp seconds relmse relmse_ci raw est eff eff_ci ratio ratio_lo ratio_hi share msps ref_noise
-# Means over the seeds; *_ci are 95% t half widths over them; the ratio to
+# Means over the seeds; *_ci are 95% t calibration_seconds widths over them; the ratio to
 # cosine is taken seed by seed (independent runs) and averaged.
 aggregate() {
   awk "$SPLIT_ROW"'
