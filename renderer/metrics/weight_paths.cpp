@@ -73,9 +73,9 @@ double TechniquePair::weight_of(const Strategy& strategy) const {
     else if (name == b) wb += weight;
     else others.emplace_back(name, weight);
   if (!(wa + wb > 0.0) || std::fabs(wa + wb - share) > 1e-6 || others.size() != rest.size()) return -1.0;
-  for (const auto& [name, weight] : others) {
-    const auto it = std::find_if(rest.begin(), rest.end(), [&](const auto& r) { return r.first == name; });
-    if (it == rest.end() || std::fabs(it->second - weight) > 1e-6) return -1.0;
+  for (const auto& term : others) {
+    const auto it = std::find_if(rest.begin(), rest.end(), [&](const auto& r) { return r.first == term.first; });
+    if (it == rest.end() || std::fabs(it->second - term.second) > 1e-6) return -1.0;
   }
   return wa / (wa + wb);
 }

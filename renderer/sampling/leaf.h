@@ -31,6 +31,8 @@ PDFLAB_LEAF Float lane_max(Float a, Float b) { return max_of(a, b); }
 PDFLAB_LEAF Int lane_trunc(Float x) { return static_cast<Int>(x); }
 PDFLAB_LEAF Float lane_float(Int x) { return static_cast<Float>(x); }
 PDFLAB_LEAF Mask lane_not(Mask m) { return !m; }
+PDFLAB_LEAF Mask lane_and(Mask a, Mask b) { return a && b; }
+PDFLAB_LEAF Mask lane_or(Mask a, Mask b) { return a || b; }
 PDFLAB_LEAF Int increment_where(Int x, Mask m) { return m ? x + 1 : x; }
 PDFLAB_LEAF bool any(Mask m) { return m; }
 PDFLAB_LEAF Float select(Mask m, Float a, Float b) { return m ? a : b; }
