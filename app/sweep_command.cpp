@@ -121,12 +121,15 @@ Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strat
 // Auto weight (weight_paths.h): the run is split into AutoWeight's passes
 // (1/16, 1/16, 1/8, 1/4, 1/2 of the time or spp); each pass renders at the
 // weight the passes before it predicted best, starting at 0.5, and the image
-// is their sample-weighted mean. Its time includes replaying paths for the
-// prediction.
+// is their sample-weighted mean. After each pass but the last, the prediction
+// traces the next few samples of the sequence with the pass's weight through
+// the one-path tracer, which records their vertices; they are added to the
+// image, and their time counts against the run.
 struct AutoRun {
   Run run;
   std::vector<double> weights;  // per pass
   double replay_seconds = 0.0;  // of run.seconds, the time spent predicting
+  CostModel cost;               // fitted to the passes' timing
 };
 
 AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePair& family, const MixtureFamily& mixtures,
@@ -136,43 +139,62 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
   const std::size_t values = reference.rgb.size();
   std::vector<double> sum(values, 0.0);
   AutoRun out;
-  double seconds = 0.0;
+  double seconds = 0.0, share = 0.0;
   std::uint32_t spp = 0;
   for (int pass = 0; pass < AutoWeight::kPasses; ++pass) {
     const double w = chooser.weight();
     out.weights.push_back(w);
+    // Each pass ends where its share of the run does, counting the samples
+    // and time of the predictions before it: the run keeps its budget.
+    share += AutoWeight::pass_share(pass);
     SweepOptions slice = o;
-    slice.seconds = o.seconds * AutoWeight::pass_share(pass);
-    slice.spp = o.spp > 0 ? std::max<std::uint32_t>(1, static_cast<std::uint32_t>(o.spp * AutoWeight::pass_share(pass))) : 0;
+    slice.seconds = o.seconds > 0 ? std::max(0.02 * o.seconds, o.seconds * share - seconds) : 0.0;
+    const auto target = static_cast<std::uint32_t>(std::lround(o.spp * share));
+    slice.spp = o.spp > 0 ? (target > spp ? target - spp : 1) : 0;
     // One seed, each pass continuing the sample indices where the last one
     // stopped: together the passes draw the very pixel positions (one
     // (0,2)-sequence per pixel) and random streams of a fixed-weight run of
     // as many samples; only the weights differ.
-    const std::uint32_t first = spp;
     std::vector<float> image;
-    const Run r = render_once(scene, family.at(w), seed, slice, reference, label, show_progress, &image, first);
+    const Run r = render_once(scene, family.at(w), seed, slice, reference, label, show_progress, &image, spp);
     for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(image[i]) * r.spp;
     spp += r.spp;
     seconds += r.seconds;
     if (pass + 1 == AutoWeight::kPasses || r.spp == 0) continue;
     // The prediction knows what a render knows: the passes so far (their mean
-    // image), not the reference.
+    // image), not the reference. Its paths must not be among the samples of
+    // that mean: a path that is also in its pixel's mean raises the mean with
+    // its own brightness, so its share of the relative second moment,
+    // F^2 / (mu^2 + eps), is held down exactly when F is large, and the
+    // prediction leans towards the weight it was drawn at (measured on the
+    // glossy box: 0.55-0.65 instead of the 0.75 that independent paths give).
+    // So the prediction traces the next samples of the sequence, which then
+    // join the image: the run still draws one unbroken sequence of samples.
     const auto start = std::chrono::steady_clock::now();
     std::vector<float> so_far(values);
     for (std::size_t i = 0; i < values; ++i) so_far[i] = static_cast<float>(sum[i] / spp);
+    Film traced(scene->camera.width, scene->camera.height);
     WeightPathOptions po;
     po.seed = seed;
-    po.first_sample = first;
+    po.first_sample = spp;
     po.samples = AutoWeight::replay_samples(r.spp);
     po.threads = o.threads;
+    po.film = &traced;
+    po.relative_to = &so_far;  // one image-wide cell: nothing per pixel to allocate
+    po.relative_epsilon = kRelMseEpsilon;
     const WeightPredictor predictor = record_weight_paths(*scene, mixtures, family.at(w), w, chooser.grid(), po);
-    chooser.add_pass(predictor.predict(so_far, r.seconds / r.spp, kRelMseEpsilon));
+    // The pass's own time per sample and its paths' rays feed the cost model.
+    chooser.add_pass(predict_image_wide(predictor, so_far, r.seconds / r.spp, kRelMseEpsilon), r.seconds / r.spp);
+    const std::vector<float> traced_mean = traced.mean_rgb();
+    for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(traced_mean[i]) * po.samples;
+    spp += po.samples;
     const double replay = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     seconds += replay;
     out.replay_seconds += replay;
   }
   std::vector<float> mean(values);
   for (std::size_t i = 0; i < values; ++i) mean[i] = spp > 0 ? static_cast<float>(sum[i] / spp) : 0.0f;
+  out.cost = chooser.cost_model();
   out.run.spp = spp;
   out.run.seconds = seconds;
   out.run.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
@@ -231,7 +253,74 @@ struct Row {
   std::uint32_t spp = 0;  // the first seed's
   Interval seconds, relmse, efficiency, samples_per_second;
   Interval predicted;  // efficiency predicted from the pilot weight's runs
+  double predicted_rays_only = 0.0;  // the same with a cost of rays alone (no fixed cost per sample)
 };
+
+// "The best fixed weight's efficiency" measured fairly. The best row's mean is
+// the largest of several noisy means and so sits high, by up to its
+// interval's width. Two estimates that do not pick and measure with the same
+// noise: the maximum of a parabola fitted by least squares to the row means
+// within 0.2 of the best row (the curve is smooth there, and the fit averages
+// the noise of five rows), and the weight chosen on half the seeds, measured
+// on the other half (both ways round, averaged).
+struct BestFixed {
+  double fitted = 0.0, fitted_weight = -1.0;
+  double held_out = 0.0;  // 0 with a single seed
+};
+
+BestFixed fair_best_fixed(const std::vector<Row>& rows, const std::vector<std::vector<double>>& eff, int best) {
+  BestFixed out;
+  if (best < 0) return out;
+  const double centre = rows[static_cast<std::size_t>(best)].weight;
+  out.fitted = rows[static_cast<std::size_t>(best)].efficiency.mean;
+  out.fitted_weight = centre;
+  // Normal equations of y = c0 + c1 x + c2 x^2, x = w - centre.
+  double m[3][4] = {};
+  int points = 0;
+  double x_lo = 0.0, x_hi = 0.0;
+  for (const Row& r : rows) {
+    const double x = r.weight - centre;
+    if (!r.unbiased || std::fabs(x) > 0.2 + 1e-9 || !std::isfinite(r.efficiency.mean)) continue;
+    const double powers[3] = {1.0, x, x * x};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) m[i][j] += powers[i] * powers[j];
+      m[i][3] += powers[i] * r.efficiency.mean;
+    }
+    x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
+    ++points;
+  }
+  if (points >= 3) {
+    for (int c = 0; c < 3; ++c) {  // Gauss-Jordan; the matrix is positive definite for 3 distinct x
+      const double pivot = m[c][c];
+      if (!(std::fabs(pivot) > 0.0)) return out;
+      for (int j = 0; j < 4; ++j) m[c][j] /= pivot;
+      for (int i = 0; i < 3; ++i)
+        if (i != c)
+          for (int j = 3; j >= 0; --j) m[i][j] -= m[i][c] * m[c][j];
+    }
+    const double c0 = m[0][3], c1 = m[1][3], c2 = m[2][3];
+    auto at = [&](double x) { return c0 + c1 * x + c2 * x * x; };
+    double x_best = at(x_lo) > at(x_hi) ? x_lo : x_hi;
+    if (c2 < 0.0) x_best = std::clamp(-c1 / (2.0 * c2), x_lo, x_hi);
+    if (at(x_best) > 0.0) out.fitted = at(x_best), out.fitted_weight = centre + x_best;
+  }
+  const std::size_t seeds = eff.empty() ? 0 : eff[0].size();
+  if (seeds >= 2) {
+    auto half_mean = [&](std::size_t row, std::size_t half) {
+      double sum = 0.0;
+      int n = 0;
+      for (std::size_t k = half; k < eff[row].size(); k += 2) sum += eff[row][k], ++n;
+      return n > 0 ? sum / n : 0.0;
+    };
+    for (std::size_t half = 0; half < 2; ++half) {
+      std::size_t chosen = static_cast<std::size_t>(best);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        if (rows[i].unbiased && half_mean(i, half) > half_mean(chosen, half)) chosen = i;
+      out.held_out += 0.5 * half_mean(chosen, 1 - half);
+    }
+  }
+  return out;
+}
 
 // Samples per pixel replayed for the prediction: the pilot run's first ones.
 constexpr std::uint32_t kPredictionSpp = 256;
@@ -298,8 +387,9 @@ int run_sweep(const SweepOptions& o) {
   // drift falls on all weights alike instead of on a few.
   const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
   std::size_t done_runs = 0;
-  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), eff(rows.size()), sps(rows.size());
-  std::vector<double> auto_eff, auto_rel, auto_sec;
+  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), eff(rows.size()), sps(rows.size()),
+      per_sample(rows.size());
+  std::vector<double> auto_eff, auto_rel, auto_sec, auto_offset;
   std::vector<std::vector<double>> auto_weights;
   for (int k = 0; k < o.seeds; ++k) {
     for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -324,6 +414,7 @@ int run_sweep(const SweepOptions& o) {
       rel[i].push_back(run.relmse);
       eff[i].push_back(run.efficiency);
       sps[i].push_back(run.samples_per_second);
+      if (run.spp > 0) per_sample[i].push_back(run.seconds / run.spp);
       if (!o.quiet && !tty)
         std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, run.spp, run.seconds,
                      run.relmse, run.efficiency);
@@ -337,6 +428,7 @@ int run_sweep(const SweepOptions& o) {
     auto_rel.push_back(a.run.relmse);
     auto_sec.push_back(a.run.seconds);
     auto_weights.push_back(a.weights);
+    auto_offset.push_back(a.cost.offset());
     if (!o.quiet && !tty)
       std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting), relMSE %.4g, efficiency %.4g\n", label, a.run.spp,
                    a.run.seconds, a.replay_seconds, a.run.relmse, a.run.efficiency);
@@ -347,6 +439,29 @@ int run_sweep(const SweepOptions& o) {
     rows[i].efficiency = interval(eff[i]);
     rows[i].samples_per_second = interval(sps[i]);
   }
+  // The cost model (weight_prediction.h): every row's measured seconds per
+  // sample against the rays per sample that the pilot's paths predict at its
+  // weight. The rows' weights spread the rays, so their times tell the fixed
+  // cost per sample from the cost per ray. The prediction is then re-priced
+  // by it; `rays_only` keeps the curve of a cost of rays alone.
+  auto grid_index = [&](double w) {
+    return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
+  };
+  std::vector<double> row_rays(rows.size(), std::nan("")), row_seconds_per_sample(rows.size(), std::nan(""));
+  CostFit cost_fit;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    row_seconds_per_sample[i] = interval(per_sample[i]).mean;
+    if (predictions.empty() || per_sample[i].empty()) continue;
+    double rays = 0.0;
+    for (const WeightPrediction& p : predictions) rays += p.cost[grid_index(rows[i].weight)] / static_cast<double>(predictions.size());
+    row_rays[i] = rays;
+    cost_fit.add(rays, row_seconds_per_sample[i]);
+  }
+  const CostModel cost_model = cost_fit.fit(AutoWeight::kPriorOffset);
+  std::vector<WeightPrediction> rays_only = predictions;
+  if (cost_model.per_ray > 0.0)
+    for (WeightPrediction& p : predictions) apply_cost_model(p, cost_model);
+
   const Interval auto_efficiency = interval(auto_eff), auto_relmse = interval(auto_rel),
                  auto_seconds = interval(auto_sec);
   if (show_progress) std::fputc('\n', stderr);
@@ -371,11 +486,9 @@ int run_sweep(const SweepOptions& o) {
       ++band_hi;
   }
   const double best_efficiency = best >= 0 ? rows[static_cast<std::size_t>(best)].efficiency.mean : 0.0;
+  const BestFixed fair = fair_best_fixed(rows, eff, best);
 
   // The prediction on each row's weight and on the fine grid, over the pilot's seeds.
-  auto grid_index = [&](double w) {
-    return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
-  };
   std::vector<double> predicted_curve(grid.size(), 0.0), predicted_best;
   for (const WeightPrediction& p : predictions) {
     for (std::size_t g = 0; g < grid.size(); ++g) predicted_curve[g] += p.efficiency[g] / static_cast<double>(predictions.size());
@@ -384,19 +497,23 @@ int run_sweep(const SweepOptions& o) {
   double predicted_max_row = 0.0;
   for (Row& r : rows) {
     if (predictions.empty()) {
-      r.predicted.mean = std::nan("");
+      r.predicted.mean = r.predicted_rays_only = std::nan("");
       continue;
     }
     std::vector<double> values;
     for (const WeightPrediction& p : predictions) values.push_back(p.efficiency[grid_index(r.weight)]);
     r.predicted = interval(values);
+    r.predicted_rays_only = 0.0;
+    for (const WeightPrediction& p : rays_only)
+      r.predicted_rays_only += p.efficiency[grid_index(r.weight)] / static_cast<double>(rays_only.size());
     if (r.unbiased) predicted_max_row = std::max(predicted_max_row, r.predicted.mean);
   }
   const Interval predicted_optimum = interval(predicted_best);
   std::string csv =
       "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
       "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
-      "predicted_efficiency_lo,predicted_efficiency_hi,predicted_relative_efficiency,best,in_best_interval\n";
+      "predicted_efficiency_lo,predicted_efficiency_hi,predicted_relative_efficiency,best,in_best_interval,rays_per_sample,seconds_per_sample,"
+      "model_seconds_per_sample,predicted_efficiency_rays_only\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const int idx = static_cast<int>(i);
@@ -410,7 +527,10 @@ int run_sweep(const SweepOptions& o) {
            num(r.predicted.hi()) + "," +
            num(predicted_max_row > 0 && r.unbiased ? r.predicted.mean / predicted_max_row : std::nan("")) + "," +
            (idx == best ? "1" : "0") + "," +
-           (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "\n";
+           (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "," + num(row_rays[i]) + "," +
+           num(row_seconds_per_sample[i]) + "," +
+           num(std::isfinite(row_rays[i]) ? cost_model.seconds(row_rays[i]) : std::nan("")) + "," +
+           num(r.predicted_rays_only) + "\n";
   }
 
   if (o.auto_weight) {
@@ -420,7 +540,7 @@ int run_sweep(const SweepOptions& o) {
            num(auto_seconds.mean) + "," + num(auto_relmse.mean) + "," + num(auto_relmse.lo()) + "," +
            num(auto_relmse.hi()) + "," + num(auto_efficiency.mean) + "," + num(auto_efficiency.lo()) + "," +
            num(auto_efficiency.hi()) + "," +
-           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0\n";
+           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0,,,,\n";
   }
   std::string plot;
   if (!o.plot.empty()) {
@@ -485,7 +605,23 @@ int run_sweep(const SweepOptions& o) {
                 rows[static_cast<std::size_t>(band_hi)].weight);
   else
     std::printf("no weight of the sweep gives an unbiased mixture\n");
+  if (best >= 0)
+    std::printf("best fixed weight's efficiency, fairly: %.4g at %.3g (the parabola through the rows within 0.2), "
+                "%.4g (chosen on half the seeds, measured on the others); the best row's mean %.4g\n",
+                fair.fitted, fair.fitted_weight, fair.held_out, best_efficiency);
+  if (cost_model.per_ray > 0.0)
+    std::printf("cost model: seconds per sample = %.4g + %.4g x rays (a fixed cost of %.2f rays; %s)\n",
+                cost_model.per_sample, cost_model.per_ray, cost_model.offset(),
+                cost_model.fitted ? "fitted to the rows' timing" : "too little spread to fit: the prior");
   if (o.auto_weight) {
+    std::printf("auto weight against the fair best fixed: %.0f%% (%.0f..%.0f%%) of the fitted, %.0f%% of the held-out;"
+                " its fitted fixed costs, rays:",
+                fair.fitted > 0 ? 100.0 * auto_efficiency.mean / fair.fitted : 0.0,
+                fair.fitted > 0 ? 100.0 * auto_efficiency.lo() / fair.fitted : 0.0,
+                fair.fitted > 0 ? 100.0 * auto_efficiency.hi() / fair.fitted : 0.0,
+                fair.held_out > 0 ? 100.0 * auto_efficiency.mean / fair.held_out : 0.0);
+    for (double v : auto_offset) std::printf(" %.2f", v);
+    std::printf("\n");
     std::printf("auto weight: efficiency %.4g +- %.2g, %.0f%% of the best fixed weight's; weights per pass:",
                 auto_efficiency.mean, auto_efficiency.half,
                 best_efficiency > 0 ? 100.0 * auto_efficiency.mean / best_efficiency : 0.0);

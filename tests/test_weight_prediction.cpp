@@ -3,6 +3,7 @@
 // numerical integration: samples drawn at one weight must predict the curve at
 // every other weight, its optimum, and each cell's own optimum.
 #include "renderer/metrics/weight_prediction.h"
+#include "renderer/metrics/weight_paths.h"
 
 #include "renderer/error.h"
 
@@ -10,6 +11,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -242,6 +244,107 @@ TEST(WeightPrediction, WeightThatCannotDrawAPathHasNoEfficiency) {
   EXPECT_NE(pred.best, 2);
   EXPECT_GT(pred.efficiency[0], 0.0);
   EXPECT_TRUE(std::isfinite(pred.efficiency[0]));
+}
+
+// The cost model t = a + b * rays, fitted to runs at several weights: noisy
+// times of a known fixed cost and cost per ray give both back.
+TEST(CostFit, RecoversTheFixedCostAndTheCostPerRay) {
+  const double a = 4e-4, b = 1.2e-3;  // seconds per pass: a fixed cost of a third of a ray
+  pdflab::CostFit fit;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i < 40; ++i) {
+    const double rays = 2.0 + 0.06 * i;  // 2 .. 4.3 rays a sample, as from w = 0.1 to 0.9
+    fit.add(rays, (a + b * rays) * (1.0 + noise(rng)));
+  }
+  fit.add(0.0, 1.0);                                       // no rays: ignored
+  fit.add(3.0, std::numeric_limits<double>::infinity());  // no time: ignored
+  EXPECT_EQ(fit.points(), 40u);
+  const pdflab::CostModel m = fit.fit(5.0);
+  EXPECT_TRUE(m.fitted);
+  EXPECT_NEAR(m.per_ray, b, 0.05 * b);
+  EXPECT_NEAR(m.per_sample, a, 0.25 * a);
+  EXPECT_NEAR(m.offset(), a / b, 0.1);
+  EXPECT_NEAR(m.seconds(3.0), a + 3.0 * b, 0.01 * (a + 3.0 * b));
+}
+
+// Rays that barely vary cannot tell the two costs apart: the mean time is
+// split by the prior. A negative fixed cost is cut to 0, and a time that falls
+// as the rays grow (noise) is no fit.
+TEST(CostFit, FallsBackToThePriorAndNeverGoesNegative) {
+  pdflab::CostFit same;
+  same.add(3.0, 1.0e-3);
+  same.add(3.01, 1.2e-3);
+  const pdflab::CostModel prior = same.fit(2.0);
+  EXPECT_FALSE(prior.fitted);
+  EXPECT_NEAR(prior.offset(), 2.0, 1e-12);
+  EXPECT_NEAR(prior.seconds(3.005), 1.1e-3, 1e-12);
+
+  pdflab::CostFit steep;  // t = -1 + rays: the fixed cost would be negative
+  for (double rays : {2.0, 3.0, 4.0}) steep.add(rays, rays - 1.0);
+  const pdflab::CostModel through_origin = steep.fit(2.0);
+  EXPECT_TRUE(through_origin.fitted);
+  EXPECT_EQ(through_origin.per_sample, 0.0);
+  EXPECT_NEAR(through_origin.per_ray, (2.0 * 1.0 + 3.0 * 2.0 + 4.0 * 3.0) / (4.0 + 9.0 + 16.0), 1e-12);
+
+  pdflab::CostFit falling;
+  falling.add(2.0, 2.0);
+  falling.add(4.0, 1.0);
+  EXPECT_FALSE(falling.fit(1.0).fitted);
+  EXPECT_NEAR(falling.fit(1.0).offset(), 1.0, 1e-12);
+  EXPECT_EQ(pdflab::CostFit().fit(1.0).per_ray, 0.0);
+}
+
+// A fixed cost per sample makes the longer paths relatively cheaper, and the
+// optimum of efficiency moves towards them; the re-priced prediction follows.
+TEST(CostFit, FixedCostMovesThePredictedOptimum) {
+  const Mixture m;
+  const auto cost = [](double x) { return x < 0.2 ? 101.0 : 1.0; };
+  const double mu = integrate(f);
+  const auto exact_cost = [&](double w) { return integrate([&](double x) { return cost(x) * m.pdf(w, x); }); };
+  const pdflab::CostModel model{60.0e-6, 1.0e-6, true};  // 60 rays of fixed cost
+  const auto exact_efficiency = [&](double w, double offset) {
+    return 1.0 / ((exact_second_moment(m, w) - mu * mu) * (exact_cost(w) + offset));
+  };
+  const double rays_only = argmax([&](double w) { return exact_efficiency(w, 0.0); });
+  const double with_fixed = argmax([&](double w) { return exact_efficiency(w, model.offset()); });
+  ASSERT_GT(std::fabs(with_fixed - rays_only), 0.04);
+
+  const std::vector<double> grid = pdflab::weight_grid(101);
+  const std::vector<float> mean = {static_cast<float>(mu), static_cast<float>(mu), static_cast<float>(mu)};
+  pdflab::WeightPrediction pred = draw(m, 0.5, 200000, 3, grid, cost).predict(mean, 0.0, 0.0);
+  EXPECT_NEAR(pred.best_weight(), rays_only, 0.02);
+  EXPECT_NEAR(pred.sampling_cost, exact_cost(0.5), 0.02 * exact_cost(0.5));
+  pdflab::apply_cost_model(pred, model);
+  EXPECT_NEAR(pred.best_weight(), with_fixed, 0.02);
+  // In the model's seconds.
+  const double rv = pred.relative_variance[30];
+  EXPECT_NEAR(pred.efficiency[30], 1.0 / (rv * model.seconds(pred.cost[30])), 1e-9 * pred.efficiency[30]);
+}
+
+// Auto weight fits the cost model to its passes' own timing (each pass's
+// seconds per sample against its paths' mean rays), and picks the optimum
+// under that model rather than under rays alone.
+TEST(CostFit, AutoWeightLearnsTheCostFromItsPasses) {
+  const Mixture m;
+  const auto cost = [](double x) { return x < 0.2 ? 101.0 : 1.0; };
+  const double mu = integrate(f);
+  const auto exact_cost = [&](double w) { return integrate([&](double x) { return cost(x) * m.pdf(w, x); }); };
+  const pdflab::CostModel truth{60.0e-6, 1.0e-6, true};
+  const double with_fixed = argmax(
+      [&](double w) { return 1.0 / ((exact_second_moment(m, w) - mu * mu) * truth.seconds(exact_cost(w))); });
+  const std::vector<float> mean = {static_cast<float>(mu), static_cast<float>(mu), static_cast<float>(mu)};
+  // A prior of no fixed cost: only the passes' timing can move the choice.
+  pdflab::AutoWeight chooser(0.3, 101, 0.0);
+  int pass = 0;
+  for (double w : {0.3, 0.7, 0.5}) {
+    const pdflab::WeightPrediction pred =
+        draw(m, w, 100000, 20 + static_cast<std::uint64_t>(pass++), chooser.grid(), cost).predict(mean, 0.0, 0.0);
+    chooser.add_pass(pred, truth.seconds(pred.sampling_cost));
+  }
+  EXPECT_TRUE(chooser.cost_model().fitted);
+  EXPECT_NEAR(chooser.cost_model().offset(), truth.offset(), 0.05 * truth.offset());
+  EXPECT_NEAR(chooser.weight(), with_fixed, 0.03);
 }
 
 TEST(WeightPrediction, DefensiveFloor) {

@@ -132,8 +132,11 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads = std::min(threads, height);
   const int block = std::max(1, o.block), blocks_x = (width + block - 1) / block;
-  std::vector<WeightPredictor> parts(static_cast<std::size_t>(threads),
-                                     WeightPredictor(block_cells(width, height, block), grid, w, weights));
+  const std::vector<float>* relative = o.relative_to;
+  if (relative && relative->size() != static_cast<std::size_t>(width * height) * 3)
+    throw InputError("weight paths: the mean image does not have the scene's size");
+  std::vector<WeightPredictor> parts(
+      static_cast<std::size_t>(threads), WeightPredictor(relative ? 1 : block_cells(width, height, block), grid, w, weights));
   const SampleSeed seed(o.seed);
   auto work = [&](int part) {
     WeightPredictor& predictor = parts[static_cast<std::size_t>(part)];
@@ -171,8 +174,15 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
               }
             }
           }
-          const float rgb[3] = {radiance.x, radiance.y, radiance.z};
-          predictor.add_path((y / block) * blocks_x + x / block, rgb, vertices, static_cast<double>(record.segments));
+          float rgb[3] = {radiance.x, radiance.y, radiance.z};
+          if (relative) {
+            const float* mu = &(*relative)[static_cast<std::size_t>(y * width + x) * 3];
+            for (int c = 0; c < 3; ++c)
+              rgb[c] = static_cast<float>(static_cast<double>(rgb[c]) /
+                                          std::sqrt(static_cast<double>(mu[c]) * mu[c] + o.relative_epsilon));
+          }
+          const int cell = relative ? 0 : (y / block) * blocks_x + x / block;
+          predictor.add_path(cell, rgb, vertices, static_cast<double>(record.segments));
         }
   };
   std::vector<std::thread> pool;
@@ -181,6 +191,23 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   for (std::thread& t : pool) t.join();
   for (std::size_t t = 1; t < parts.size(); ++t) parts[0].merge(parts[t]);
   return std::move(parts[0]);
+}
+
+WeightPrediction predict_image_wide(const WeightPredictor& predictor, const std::vector<float>& mean,
+                                    double seconds_per_sample, double epsilon) {
+  // The cell's moment is the mean of F^2 R / (mu^2 + eps) over all paths (each
+  // pixel has as many); subtracting the mean of mu^2 / (mu^2 + eps) with a
+  // unit denominator leaves the mean relative variance.
+  std::vector<float> unit = {1.0f, 1.0f, 1.0f}, square(3, 0.0f);
+  double sums[3] = {0.0, 0.0, 0.0};
+  const std::size_t pixels = mean.size() / 3;
+  for (std::size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double mu = static_cast<double>(mean[i * 3 + static_cast<std::size_t>(c)]);
+      sums[c] += mu * mu / (mu * mu + epsilon);
+    }
+  for (int c = 0; c < 3; ++c) square[static_cast<std::size_t>(c)] = static_cast<float>(sums[c] / static_cast<double>(std::max<std::size_t>(1, pixels)));
+  return predictor.predict(unit, seconds_per_sample, 0.0, 0.0, &square);
 }
 
 double AutoWeight::pass_share(int pass) {
@@ -192,19 +219,29 @@ std::uint32_t AutoWeight::replay_samples(std::uint32_t pass_spp) {
   return std::min(pass_spp, std::clamp<std::uint32_t>(pass_spp / 32, 1, 8));
 }
 
-AutoWeight::AutoWeight(double first, int grid_points)
-    : grid_(weight_grid(grid_points)), sum_(grid_.size(), 0.0), history_{defended_weight(first)} {}
+AutoWeight::AutoWeight(double first, int grid_points, double prior_offset)
+    : grid_(weight_grid(grid_points)), prior_offset_(prior_offset), history_{defended_weight(first)} {}
 
-void AutoWeight::add_pass(const WeightPrediction& prediction) {
+void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per_sample) {
   if (prediction.efficiency.size() != grid_.size()) return;
-  ++passes_;
-  // Each pass's curve counts by its paths: a pass that replayed more has the less noisy curve.
-  const double paths = static_cast<double>(prediction.paths);
-  for (std::size_t g = 0; g < grid_.size(); ++g) sum_[g] += paths * prediction.efficiency[g];
+  passes_.push_back(prediction);
+  if (seconds_per_sample > 0.0) {
+    fit_.add(prediction.sampling_cost, seconds_per_sample);
+    model_ = fit_.fit(prior_offset_, kFitSpread);
+  }
+  // Each pass's curve counts by its paths: a pass that replayed more has the
+  // less noisy curve. With timed passes every curve is re-priced by the
+  // latest cost model, so the earlier ones learn from the later timing too.
+  std::vector<double> sum(grid_.size(), 0.0);
+  for (WeightPrediction p : passes_) {
+    if (model_.per_ray > 0.0) apply_cost_model(p, model_);
+    const double paths = static_cast<double>(p.paths);
+    for (std::size_t g = 0; g < grid_.size(); ++g) sum[g] += paths * p.efficiency[g];
+  }
   std::size_t best = 0;
   for (std::size_t g = 1; g < grid_.size(); ++g)
-    if (sum_[g] > sum_[best]) best = g;
-  history_.push_back(sum_[best] > 0.0 ? defended_weight(grid_[best]) : history_.back());
+    if (sum[g] > sum[best]) best = g;
+  history_.push_back(sum[best] > 0.0 ? defended_weight(grid_[best]) : history_.back());
 }
 
 }  // namespace pdflab

@@ -58,7 +58,21 @@ struct WeightPathOptions {
   // The predictor's cells: block x block pixels each (the right and bottom
   // ones may be cut), row by row; 1: one cell per pixel.
   int block = 1;
+  // When given (each pixel's mean, RGB): one cell for the whole image, each
+  // path's estimate divided per channel by sqrt(mean^2 + relative_epsilon), so
+  // that the cell's second moment is the image's mean relative one (see
+  // predict_image_wide). A few hundred bytes however large the image: what
+  // auto weight needs, without a per-pixel table to allocate every pass.
+  const std::vector<float>* relative_to = nullptr;
+  double relative_epsilon = 0.0;
 };
+
+// The image-wide prediction of a predictor recorded with `relative_to` =
+// `mean` (the same image and epsilon): the relative variance is the mean over
+// pixels and channels of (M - mu^2) / (mu^2 + epsilon), as predict() gives
+// with one cell per pixel.
+WeightPrediction predict_image_wide(const WeightPredictor& predictor, const std::vector<float>& mean,
+                                    double seconds_per_sample, double epsilon);
 
 // How many cells of `block` pixels a side cover a width x height image.
 inline int block_cells(int width, int height, int block) {
@@ -95,24 +109,42 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
 // pass, 1 to 8: predicting costs several per cent of a short run, less of a
 // long one), and the next weight is the best of the passes' predicted curves
 // so far, each counted by its number of paths.
+//
+// The time a weight costs comes from a CostModel (weight_prediction.h) fitted
+// to the passes' own timing: each pass gives its seconds per sample and its
+// paths' mean rays. Until the passes' rays spread enough to tell the fixed
+// cost per sample from the cost per ray, the fixed cost is `prior_offset` rays.
 class AutoWeight {
  public:
   static constexpr int kPasses = 5;
+  // The fixed cost per sample, in rays, assumed until the passes measure it:
+  // about what sweeps of the shipped scenes fit (docs/measuring.md).
+  static constexpr double kPriorOffset = 0.5;
+  // The passes' rays must spread by this share of their mean before their
+  // times are fitted: a few passes of noisy times at nearby weights cannot
+  // tell a fixed cost from a cost per ray.
+  static constexpr double kFitSpread = 0.25;
   static double pass_share(int pass);  // of the run, for pass 0 .. kPasses - 1
   static std::uint32_t replay_samples(std::uint32_t pass_spp);
 
-  explicit AutoWeight(double first = 0.5, int grid_points = 21);
+  explicit AutoWeight(double first = 0.5, int grid_points = 21, double prior_offset = kPriorOffset);
   double weight() const { return history_.back(); }  // for the next pass
-  // A finished pass's prediction (on grid()): the next weight is the best of
-  // the path-weighted mean predicted efficiency so far, kept inside the
-  // defensive floor.
-  void add_pass(const WeightPrediction& prediction);
+  // A finished pass's prediction (on grid()) and its measured seconds per
+  // sample (one sample in every cell; 0: unknown, the prediction's own
+  // efficiency is used): the next weight is the best of the path-weighted mean
+  // predicted efficiency so far under the cost model fitted so far, kept
+  // inside the defensive floor.
+  void add_pass(const WeightPrediction& prediction, double seconds_per_sample = 0.0);
   const std::vector<double>& grid() const { return grid_; }
   const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next
+  const CostModel& cost_model() const { return model_; }           // the latest fit (zero before a timed pass)
 
  private:
-  std::vector<double> grid_, sum_;
-  int passes_ = 0;
+  std::vector<double> grid_;
+  double prior_offset_;
+  std::vector<WeightPrediction> passes_;
+  CostFit fit_;
+  CostModel model_;
   std::vector<double> history_;
 };
 

@@ -117,6 +117,7 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
   // ratio estimate has less noise than the plain mean when R varies a lot. The
   // measured time per sample belongs to the plain mean cost at the sampling weight.
   const double cost_here = plain_cost_sum_ / static_cast<double>(paths_);
+  p.sampling_cost = cost_here;
   double best = -1.0;
   for (std::size_t g = 0; g < grid_size; ++g) {
     p.relative_variance[g] = std::max(0.0, p.relative_variance[g] / static_cast<double>(terms));
@@ -131,6 +132,55 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
   }
   if (!(best > 0.0)) p.best = -1;
   return p;
+}
+
+void CostFit::add(double rays, double seconds) {
+  if (!(rays > 0.0 && std::isfinite(rays) && seconds > 0.0 && std::isfinite(seconds))) return;
+  x_.push_back(rays);
+  y_.push_back(seconds);
+}
+
+CostModel CostFit::fit(double prior_offset, double min_spread) const {
+  CostModel m;
+  if (x_.empty()) return m;
+  const double n = static_cast<double>(x_.size());
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < x_.size(); ++i) mx += x_[i] / n, my += y_[i] / n;
+  const auto [lo, hi] = std::minmax_element(x_.begin(), x_.end());
+  if (x_.size() >= 2 && *hi - *lo >= min_spread * mx) {
+    double sxx = 0.0, sxy = 0.0;
+    for (std::size_t i = 0; i < x_.size(); ++i) sxx += (x_[i] - mx) * (x_[i] - mx), sxy += (x_[i] - mx) * (y_[i] - my);
+    const double slope = sxy / sxx;
+    if (slope > 0.0) {
+      m.fitted = true;
+      m.per_ray = slope;
+      m.per_sample = my - slope * mx;
+      if (m.per_sample < 0.0) {  // no negative fixed cost: all of it per ray, through the origin
+        double xx = 0.0, xy = 0.0;
+        for (std::size_t i = 0; i < x_.size(); ++i) xx += x_[i] * x_[i], xy += x_[i] * y_[i];
+        m.per_sample = 0.0;
+        m.per_ray = xy / xx;
+      }
+      return m;
+    }
+  }
+  // Too little spread (or time falling with rays, which is noise): the mean
+  // time, split between the fixed cost and the rays by the prior.
+  const double offset = std::max(0.0, prior_offset);
+  m.per_ray = my / (mx + offset);
+  m.per_sample = offset * m.per_ray;
+  return m;
+}
+
+void apply_cost_model(WeightPrediction& p, const CostModel& model) {
+  p.best = -1;
+  double best = -1.0;
+  for (std::size_t g = 0; g < p.weight.size() && g < p.efficiency.size(); ++g) {
+    const double denominator = p.relative_variance[g] * model.seconds(p.cost[g]);
+    p.efficiency[g] = std::isfinite(denominator) && denominator > 0.0 ? 1.0 / denominator : 0.0;
+    if (p.efficiency[g] > best) best = p.efficiency[g], p.best = static_cast<int>(g);
+  }
+  if (!(best > 0.0)) p.best = -1;
 }
 
 std::vector<float> WeightPredictor::best_weight_map(const std::vector<float>& mean_rgb, double epsilon) const {

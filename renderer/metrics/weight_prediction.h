@@ -65,9 +65,48 @@ struct WeightPrediction {
   std::vector<double> cost;             // expected cost of a path (segments traced)
   std::vector<double> efficiency;       // 1 / (relative_variance * seconds per pass); 0 where infinite variance
   std::uint64_t paths = 0;
+  double sampling_cost = 0.0;           // mean cost of the recorded paths, at the sampling weight
   int best = -1;                        // index of the highest efficiency; -1 when none is finite
   double best_weight() const { return best >= 0 ? weight[static_cast<std::size_t>(best)] : -1.0; }
 };
+
+// The time a sample takes against the rays it traces, t = per_sample +
+// per_ray * rays: a path tracer spends per ray (intersection, shading, the
+// next direction) and per sample whatever the path's length (the camera ray's
+// set-up, the pixel's sample point, the film's accumulation, the pass's
+// bookkeeping). Counting rays alone overstates how much dearer a weight with
+// longer paths is.
+struct CostModel {
+  double per_sample = 0.0;  // seconds
+  double per_ray = 0.0;     // seconds
+  bool fitted = false;      // from the runs' timing (false: the prior fixed cost)
+  double seconds(double rays) const { return per_sample + per_ray * rays; }
+  // The fixed cost in rays, per_sample / per_ray (0 without a per-ray cost).
+  double offset() const { return per_ray > 0.0 ? per_sample / per_ray : 0.0; }
+};
+
+// Least-squares fit of a CostModel to (rays per sample, seconds per sample)
+// points: runs at different weights trace paths of different lengths, and
+// their times tell the two costs apart.
+class CostFit {
+ public:
+  // Points with a non-positive or non-finite value are ignored.
+  void add(double rays_per_sample, double seconds_per_sample);
+  // The fit when the points' rays spread by at least `min_spread` of their
+  // mean and it gives a positive cost per ray (a negative fixed cost is cut to
+  // 0, refitted through the origin). Otherwise the points' mean time split with
+  // `prior_offset` rays of fixed cost, not `fitted`. No points: all zero.
+  CostModel fit(double prior_offset, double min_spread = 0.05) const;
+  std::size_t points() const { return x_.size(); }
+
+ private:
+  std::vector<double> x_, y_;
+};
+
+// The prediction's efficiency under `model`: 1 / (relative variance *
+// model.seconds(cost)) at each weight, and its best. The model's units are the
+// efficiency's: seconds per sample of every cell gives a render's efficiency.
+void apply_cost_model(WeightPrediction& prediction, const CostModel& model);
 
 // Accumulates paths drawn at one sampling weight, per cell (a pixel, or a block
 // of pixels), and predicts over the grid. Not thread-safe: give each thread its
