@@ -221,9 +221,17 @@ int run_bench(const BenchOptions& o) {
     po.seed = o.seed;
     po.samples = std::min(pilot.spp, kPredictionSpp);
     po.threads = o.threads;
-    const WeightPrediction p =
-        record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po)
-            .predict(reference.rgb, pilot.seconds / pilot.spp, kRelMseEpsilon);
+    WeightPrediction p = record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po)
+                             .predict(reference.rgb, pilot.seconds / pilot.spp, kRelMseEpsilon);
+    // The cost model (weight_prediction.h): the members' measured seconds per
+    // sample against the rays per sample predicted at their weights.
+    CostFit cost_fit;
+    for (std::size_t i = 0; i < results.size(); ++i)
+      if (prediction.weights[i] >= 0.0 && results[i].spp > 0) {
+        const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
+        cost_fit.add(p.cost[static_cast<std::size_t>(g)], results[i].seconds / results[i].spp);
+      }
+    apply_cost_model(p, cost_fit.fit(AutoWeight::kPriorOffset));
     predicted_best = p.best_weight();
     for (std::size_t i = 0; i < results.size(); ++i)
       if (prediction.weights[i] >= 0.0) {

@@ -322,8 +322,11 @@ BestFixed fair_best_fixed(const std::vector<Row>& rows, const std::vector<std::v
   return out;
 }
 
-// Samples per pixel replayed for the prediction: the pilot run's first ones.
+// Samples per pixel replayed for the prediction: the pilot run's first ones,
+// up to 256 and about 2^19 paths in all (each path is reweighted at every
+// weight of a fine grid, so the replay's time grows with paths x grid).
 constexpr std::uint32_t kPredictionSpp = 256;
+constexpr std::uint64_t kPredictionPaths = std::uint64_t{1} << 19;
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "";
@@ -403,7 +406,9 @@ int run_sweep(const SweepOptions& o) {
       if (static_cast<int>(i) == pilot && run.spp > 0) {
         WeightPathOptions po;
         po.seed = seeds[static_cast<std::size_t>(k)];
-        po.samples = std::min(run.spp, kPredictionSpp);
+        const std::uint64_t pixels = static_cast<std::uint64_t>(scene->camera.width) * static_cast<std::uint64_t>(scene->camera.height);
+        po.samples = std::min({run.spp, kPredictionSpp,
+                               static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (kPredictionPaths + pixels - 1) / pixels))});
         po.threads = o.threads;
         const WeightPredictor predictor = record_weight_paths(*scene, mixture_family, r.strategy, r.weight, grid, po);
         if (!o.map.empty() && map_png.empty())

@@ -2,6 +2,7 @@
 // tracer's record does not change a path, and the second moment predicted at
 // one weight from paths drawn at another equals the one measured from paths
 // drawn at that weight, on the book's box.
+#include "renderer/error.h"
 #include "renderer/integrator/integrator.h"
 #include "renderer/metrics/weight_paths.h"
 #include "renderer/scene/scene_loader.h"
@@ -115,6 +116,9 @@ namespace {
 // Auto weight: passes whose weights come from earlier passes' predictions sum
 // to the same image as a fixed weight (a chi-square over pixels and channels of
 // the difference in units of its standard error), and the weight did move.
+// As sweep --auto does: one seed, each pass continuing the sample indices; a
+// pass renders its samples, then the prediction traces the next ones, which
+// join the image, predicted against the mean of the samples before them.
 TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
   const Scene scene = small_box(8);
   const MixtureFamily family = cosine_light();
@@ -126,19 +130,28 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
   WeightPathOptions o;
   o.threads = 2;
   o.film = &automatic;
-  o.samples = 512;
-  // As sweep --auto does: one seed, each pass continuing the sample indices.
   o.seed = 100;
+  std::uint32_t next = 0;
   for (int pass = 0; pass < 4; ++pass) {
     const double w = chooser.weight();
     char text[64];
     std::snprintf(text, sizeof text, "mix:cosine=%.9g,light=%.9g", w, 1.0 - w);
-    o.first_sample = static_cast<std::uint32_t>(pass) * o.samples;
-    const WeightPredictor p = record_weight_paths(scene, family, Strategy::parse(text), w, chooser.grid(), o);
-    // The pass's own mean as mu: what a render knows (no reference).
+    // The pass itself: its prediction is not used.
+    o.first_sample = next;
+    o.samples = 256;
+    o.relative_to = nullptr;
+    (void)record_weight_paths(scene, family, Strategy::parse(text), w, {w}, o);
+    next += o.samples;
+    // The prediction: the next samples, against the mean before them (what a
+    // render knows; no reference), one image-wide cell.
     std::vector<float> mean;
     automatic.mean_rgb(mean);
-    chooser.add_pass(p.predict(mean, 0.0, 0.01));
+    o.first_sample = next;
+    o.relative_to = &mean;
+    o.relative_epsilon = 0.01;
+    const WeightPredictor p = record_weight_paths(scene, family, Strategy::parse(text), w, chooser.grid(), o);
+    next += o.samples;
+    chooser.add_pass(predict_image_wide(p, mean, 1e-4, 0.01), 1e-4);
   }
   ASSERT_EQ(chooser.history().size(), 5u);
   EXPECT_GT(chooser.history()[1], 0.3) << "the prediction did not move the weight";
@@ -150,6 +163,7 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
 
   Film fixed(8, 8);
   o.film = &fixed;
+  o.relative_to = nullptr;
   o.samples = 2048;
   o.first_sample = 0;
   o.seed = 7;
@@ -179,6 +193,44 @@ TEST(WeightPaths, AutoWeightConvergesToTheFixedWeightsImage) {
 }  // namespace
 
 namespace {
+
+// One image-wide cell of paths divided by sqrt(mu^2 + eps) predicts the same
+// relative variance and cost as one cell per pixel with the same means.
+TEST(WeightPaths, ImageWideCellEqualsPerPixelCells) {
+  const Scene scene = small_box(8);
+  const MixtureFamily family = cosine_light();
+  const Strategy mixture = Strategy::parse("mix:cosine=0.4,light=0.6");
+  const std::vector<double> grid = weight_grid(11);
+  WeightPathOptions o;
+  o.threads = 2;
+  o.seed = 9;
+  o.samples = 64;
+  Film film(8, 8);
+  o.film = &film;
+  (void)record_weight_paths(scene, family, mixture, 0.4, {0.4}, o);
+  std::vector<float> mean;
+  film.mean_rgb(mean);
+  o.film = nullptr;
+  o.seed = 10;  // paths independent of the mean
+  const WeightPrediction per_pixel =
+      record_weight_paths(scene, family, mixture, 0.4, grid, o).predict(mean, 1e-3, 0.01);
+  o.relative_to = &mean;
+  o.relative_epsilon = 0.01;
+  const WeightPredictor wide = record_weight_paths(scene, family, mixture, 0.4, grid, o);
+  EXPECT_EQ(wide.paths(), per_pixel.paths);
+  const WeightPrediction image_wide = predict_image_wide(wide, mean, 1e-3, 0.01);
+  ASSERT_EQ(image_wide.relative_variance.size(), grid.size());
+  for (std::size_t g = 1; g < grid.size(); ++g) {
+    EXPECT_NEAR(image_wide.relative_variance[g], per_pixel.relative_variance[g],
+                1e-4 * per_pixel.relative_variance[g]) << grid[g];
+    EXPECT_NEAR(image_wide.cost[g], per_pixel.cost[g], 1e-9 * per_pixel.cost[g]);
+  }
+  EXPECT_GT(per_pixel.relative_variance[5], 0.0);
+  EXPECT_EQ(image_wide.best, per_pixel.best);
+  std::vector<float> wrong(3, 0.5f);
+  o.relative_to = &wrong;
+  EXPECT_THROW((void)record_weight_paths(scene, family, mixture, 0.4, grid, o), InputError);
+}
 
 // "Which technique found the light": the shares of every path with light sum
 // to the luminance it carried, and cosine's share of the light found through a
