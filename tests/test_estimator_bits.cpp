@@ -26,17 +26,20 @@ struct BitsCase {
 };
 
 // Recorded before Russian roulette existed; the strategies' text is as it was then.
+// The book's glass sphere and the gold sphere of glossy_metal are intersected
+// in float since (Sphere::float_test), with a larger hit error: the scenes'
+// renders that reach the light through a sphere were recorded again then.
 const BitsCase kCases[] = {
-    {"cornell_book.json", "mix:cosine=0.5,light=0.5", 0xcc3c3b41dbf8ec22ull},
+    {"cornell_book.json", "mix:cosine=0.5,light=0.5", 0xd2524c53c7d3c273ull},
     {"cornell_book.json", "cosine", 0xfa6ecc62d31e386full},
-    {"cornell_book.json", "mix:cosine=0.5,light-sa=0.5", 0xa83bf492ac9287deull},
-    {"cornell_book.json", "nee-mis", 0xb7186fba31d6f4fbull},
-    {"cornell_book.json", "nee-mis:balance", 0x4d505c799510c820ull},
+    {"cornell_book.json", "mix:cosine=0.5,light-sa=0.5", 0x66a54c2fd6d8953full},
+    {"cornell_book.json", "nee-mis", 0xede69baa52ef9a57ull},
+    {"cornell_book.json", "nee-mis:balance", 0xaed8c29e61471623ull},
     {"small_light.json", "mix:cosine=0.5,light=0.5", 0xfa62f592b60f712aull},
     {"small_light.json", "nee-mis", 0x2fd0559000d67187ull},
     {"two_lights.json", "mix:cosine=0.25,uniform-hemisphere=0.25,light-sa=0.5", 0xfdca2a3e53f97dc4ull},
     {"far_light.json", "nee-mis", 0xe65cbbdf8056a3aeull},
-    {"glossy_metal.json", "mix:cosine=0.5,light=0.5", 0x7bb033754f439321ull},
+    {"glossy_metal.json", "mix:cosine=0.5,light=0.5", 0x14e9e65999daad82ull},
     {"cornell_aluminium.json", "mix:cosine=0.5,light=0.5", 0xdb7daeff13ad9dbdull},
     {"large_light.json", "uniform-sphere", 0xf6b14db33ace43d3ull},
 };

@@ -10,7 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -290,6 +292,76 @@ TEST(Extremes, ThinWallAtLargeCoordinatesDoesNotLeakLight) {
       ASSERT_EQ(m[0] + m[1] + m[2], 0.0) << strategy << ": light leaked into pixel " << p;
     }
   }
+}
+
+TEST(Extremes, SpheresLargeAgainstTheSceneAreTestedInFloat) {
+  const Scene book = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  ASSERT_EQ(book.spheres.size(), 1u);
+  EXPECT_TRUE(book.spheres[0].float_test);  // radius 90 in a scene 800 across
+  const Scene far = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/far_light.json");
+  ASSERT_EQ(far.spheres.size(), 1u);
+  EXPECT_FALSE(far.spheres[0].float_test);  // radius 3000 at 1e5: double
+  // A ground sphere through the origin, 1e3 wide under a scene 1 wide: double.
+  const Scene ground = load_scene_text(R"({"camera": {"width": 4, "height": 4, "vfov": 40, "lookfrom": [0, 1, -1], "lookat": [0, 0, 0]},
+    "materials": {"white": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [{"type": "sphere", "center": [0, -1000, 0], "radius": 1000, "material": "white"}]})",
+                                       "ground.json");
+  ASSERT_EQ(ground.spheres.size(), 1u);
+  EXPECT_FALSE(ground.spheres[0].float_test);
+}
+
+TEST(Extremes, FloatSphereTestStaysWithinItsHitErrorBound) {
+  // Spheres tested in float (Sphere::float_test) at scales 1e-3 to 1e6, with
+  // centres and ray origins anywhere within the 16 radii that Scene::prepare
+  // allows: every hit point lies within its error bound of the sphere
+  // (measured in long double), a ray leaving it outward from its offset origin
+  // never meets the sphere again, and one leaving inward meets its far side.
+  Rng rng(5, 9);
+  double worst = 0.0;  // the largest distance from the sphere over the float test's share of the bound
+  int hits = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const float r = std::pow(10.0f, -3.0f + 9.0f * rng.uniform());
+    const float extent = 16.0f * r;
+    const auto inside = [&](float half) {
+      return Vec3((2.0f * rng.uniform() - 1.0f) * half, (2.0f * rng.uniform() - 1.0f) * half,
+                  (2.0f * rng.uniform() - 1.0f) * half);
+    };
+    Sphere s{inside(extent - r), r, 0};
+    s.float_test = true;
+    const Vec3 o = inside(extent);
+    // Aimed at a point near the sphere's silhouette or across it, grazing included.
+    const Vec3 aim = s.center + sample_uniform_sphere(rng.uniform(), rng.uniform()).direction * (r * (0.9f + 0.11f * rng.uniform()));
+    if (aim == o) continue;
+    const Vec3 d = normalize(aim - o);
+    bool hit = false;
+    const float t = leaf::sphere_hit_distance(s, o, d, kInf, hit);
+    if (!hit) continue;
+    ++hits;
+    const Vec3 p = o + d * t;
+    const float error = leaf::sphere_hit_error(o, t, p, r);
+    const auto ld = [](float x) { return static_cast<long double>(x); };
+    const long double dx = ld(p.x) - ld(s.center.x), dy = ld(p.y) - ld(s.center.y), dz = ld(p.z) - ld(s.center.z);
+    const long double off = std::fabs(std::sqrt(dx * dx + dy * dy + dz * dz) - ld(r));
+    ASSERT_LE(off, ld(error)) << i;
+    worst = std::max(worst, static_cast<double>(off / (ld(64.0f * leaf::kFloatEpsilon) * (ld(t) + ld(r)))));
+    const Vec3 n = normalize(p - s.center);
+    // Leaving outward: a convex sphere is never met again.
+    const Vec3 out = sample_cosine_hemisphere(Onb(n), rng.uniform(), rng.uniform()).direction;
+    bool again = false;
+    leaf::sphere_hit_distance(s, leaf::offset_origin(p, n, error), out, kInf, again);
+    ASSERT_FALSE(again) << i;
+    // Leaving inward: the far side, a chord of 2 r cos away, not the point left.
+    const Vec3 in = sample_cosine_hemisphere(Onb(-n), rng.uniform(), rng.uniform()).direction;
+    const float chord = 2.0f * r * dot(in, -n);
+    if (chord < 1e3f * error) continue;
+    bool far_side = false;
+    const float t_in = leaf::sphere_hit_distance(s, leaf::offset_origin(p, -n, error), in, kInf, far_side);
+    ASSERT_TRUE(far_side) << i;
+    ASSERT_GT(t_in, 0.5f * chord) << i;  // the offset itself moves the far side a little
+  }
+  EXPECT_GT(hits, 50000);
+  EXPECT_LT(worst, 0.5);  // 64 eps (t + r) has room
+  std::printf("float sphere test: worst distance from the sphere %.3f of 64 eps (t + r), %d hits\n", worst, hits);
 }
 
 TEST(Extremes, IntersectionIsTheSameWithAndWithoutTheSimdBatch) {

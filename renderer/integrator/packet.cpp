@@ -5,6 +5,7 @@
 #include <cstring>
 #include <numbers>
 #include <string_view>
+#include <type_traits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>

@@ -7,6 +7,7 @@
 #include "renderer/scene/scene.h"
 
 #include <cstdint>
+#include <type_traits>
 
 namespace pdflab {
 

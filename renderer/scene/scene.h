@@ -35,6 +35,9 @@ struct Sphere {
   Vec3 center;
   float radius;
   std::uint32_t material;
+  // Intersected in float rather than double (leaf::sphere_hit_distance); set
+  // by Scene::prepare for a sphere large against the scene.
+  bool float_test = false;
 };
 
 // Builds a quad with its derived plane data (computed in double). Throws
