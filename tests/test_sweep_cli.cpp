@@ -134,7 +134,8 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
   std::vector<std::string> header;
   const auto rows = read_csv(slurp(in_work("out.csv")), header);
   for (const char* column : {"weight", "relmse", "relmse_lo", "relmse_hi", "efficiency", "efficiency_lo",
-                             "efficiency_hi", "samples_per_second", "predicted_efficiency", "best", "in_best_interval"})
+                             "efficiency_hi", "samples_per_second", "predicted_efficiency", "best", "in_best_interval",
+                             "rays_per_sample", "seconds_per_sample", "model_seconds_per_sample"})
     EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
   ASSERT_EQ(rows.size(), 5u);
   const double expected_weights[5] = {0.0, 0.25, 0.5, 0.75, 1.0};
@@ -149,6 +150,10 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
     EXPECT_LE(number(rows[i], "efficiency_lo"), number(rows[i], "efficiency"));
     EXPECT_GE(number(rows[i], "efficiency_hi"), number(rows[i], "efficiency"));
     if (rows[i].at("best") == "1") best = static_cast<int>(i), ++bests;
+    // Every path traces at least its camera ray; the cost model gives every row a time.
+    EXPECT_GE(number(rows[i], "rays_per_sample"), 1.0) << i;
+    EXPECT_GT(number(rows[i], "seconds_per_sample"), 0.0) << i;
+    EXPECT_GT(number(rows[i], "model_seconds_per_sample"), 0.0) << i;
     // Predicted from the paths at 0.5: positive for every unbiased mixture.
     if (i > 0) {
       EXPECT_GT(number(rows[i], "predicted_efficiency"), 0.0) << i;
@@ -202,6 +207,8 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
   EXPECT_EQ(be32(16), 12u * 6u);
   EXPECT_EQ(be32(20), 8u * 6u + 4u + 16u);
   EXPECT_NE(r.out.find("predicted best weight"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("best fixed weight's efficiency, fairly"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cost model: seconds per sample"), std::string::npos) << r.out;
 }
 
 }  // namespace
