@@ -117,8 +117,8 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
 class AutoWeight {
  public:
   static constexpr int kPasses = 5;
-  // The fixed cost per sample, in rays, assumed until the passes measure it:
-  // about what sweeps of the shipped scenes fit (docs/measuring.md).
+  // The fixed cost per sample, in rays, assumed until the passes measure it
+  // (sweeps of the shipped scenes fit 0 to 2.5, docs/measuring.md).
   static constexpr double kPriorOffset = 0.5;
   // The passes' rays must spread by this share of their mean before their
   // times are fitted: a few passes of noisy times at nearby weights cannot
