@@ -221,17 +221,22 @@ int run_bench(const BenchOptions& o) {
     po.seed = o.seed;
     po.samples = std::min(pilot.spp, kPredictionSpp);
     po.threads = o.threads;
-    WeightPrediction p = record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po)
-                             .predict(reference.rgb, pilot.seconds / pilot.spp, kRelMseEpsilon);
+    const WeightPredictor predictor =
+        record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po);
+    const double seconds_per_sample = pilot.seconds / pilot.spp;
+    WeightPrediction p = predictor.predict(reference.rgb, seconds_per_sample, kRelMseEpsilon);
     // The cost model (weight_prediction.h): the members' measured seconds per
-    // sample against the rays per sample predicted at their weights.
+    // sample against the rays per sample predicted at their weights give the
+    // fixed cost's share; the time stays anchored at the pilot's own, so that a
+    // few short, noisy runs cannot move the prediction at the pilot's weight.
     CostFit cost_fit;
     for (std::size_t i = 0; i < results.size(); ++i)
       if (prediction.weights[i] >= 0.0 && results[i].spp > 0) {
         const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
         cost_fit.add(p.cost[static_cast<std::size_t>(g)], results[i].seconds / results[i].spp);
       }
-    apply_cost_model(p, cost_fit.fit(AutoWeight::kPriorOffset));
+    const double offset = std::clamp(cost_fit.fit(AutoWeight::kPriorOffset).offset(), 0.0, 10.0);
+    p = predictor.predict(reference.rgb, seconds_per_sample, kRelMseEpsilon, offset);
     predicted_best = p.best_weight();
     for (std::size_t i = 0; i < results.size(); ++i)
       if (prediction.weights[i] >= 0.0) {

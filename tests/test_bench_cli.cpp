@@ -273,8 +273,8 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
 // --predict: every mixture of the pair gets its weight and the efficiency
 // predicted from the pilot's paths (the mixture nearest 0.5). At the pilot's
 // own weight the prediction is the pilot's measured efficiency in expectation
-// (the same samples; the time per pass from the cost model fitted to the
-// members' times); the others are positive.
+// (the same samples and time per pass; the members' times give only the
+// fixed cost's share); the others are positive.
 TEST_F(BenchCommand, PredictsTheMixturesEfficiencyFromThePilotsPaths) {
   // A reference far less noisy than the runs: with one as noisy as a run, the
   // measured relMSE (corrected for the reference's noise) is itself mostly noise.
