@@ -29,15 +29,21 @@ struct BitsCase {
 // The book's glass sphere and the gold sphere of glossy_metal are intersected
 // in float since (Sphere::float_test), with a larger hit error: the scenes'
 // renders that reach the light through a sphere were recorded again then.
+// The light-sa and nee-mis cases were recorded again when spherical rectangles
+// moved to float (leaf::spherical_rectangle: the same density to 1e-5, a sample
+// within 1e-3 of the light's extent of the double form's, and a one-sided light
+// seen from behind sampled by area); far_light's sun is outside the float form's
+// domain and keeps its bits. The book mixture and every strategy without a
+// solid-angle technique keep theirs.
 const BitsCase kCases[] = {
     {"cornell_book.json", "mix:cosine=0.5,light=0.5", 0xd2524c53c7d3c273ull},
     {"cornell_book.json", "cosine", 0xfa6ecc62d31e386full},
-    {"cornell_book.json", "mix:cosine=0.5,light-sa=0.5", 0x66a54c2fd6d8953full},
-    {"cornell_book.json", "nee-mis", 0xede69baa52ef9a57ull},
-    {"cornell_book.json", "nee-mis:balance", 0xaed8c29e61471623ull},
+    {"cornell_book.json", "mix:cosine=0.5,light-sa=0.5", 0xb545cefa5220f6e9ull},
+    {"cornell_book.json", "nee-mis", 0x44e3516a8dda7b9cull},
+    {"cornell_book.json", "nee-mis:balance", 0x419059255f04d5c1ull},
     {"small_light.json", "mix:cosine=0.5,light=0.5", 0xfa62f592b60f712aull},
-    {"small_light.json", "nee-mis", 0x2fd0559000d67187ull},
-    {"two_lights.json", "mix:cosine=0.25,uniform-hemisphere=0.25,light-sa=0.5", 0xfdca2a3e53f97dc4ull},
+    {"small_light.json", "nee-mis", 0xf217a3b0f9559d19ull},
+    {"two_lights.json", "mix:cosine=0.25,uniform-hemisphere=0.25,light-sa=0.5", 0x2c6f335936b719fbull},
     {"far_light.json", "nee-mis", 0xe65cbbdf8056a3aeull},
     {"glossy_metal.json", "mix:cosine=0.5,light=0.5", 0x14e9e65999daad82ull},
     {"cornell_aluminium.json", "mix:cosine=0.5,light=0.5", 0xdb7daeff13ad9dbdull},

@@ -1,5 +1,7 @@
 #include "renderer/integrator/integrator.h"
 
+#include "renderer/sampling/mixture.h"
+
 namespace pdflab {
 
 std::string_view drop_reason_name(DropReason r) {
@@ -56,19 +58,20 @@ bool roulette_survives(const SamplingPlan& plan, int depth, Vec3& throughput, co
 // sample of the plan's mixture (cosine alone for plain nee-mis) that continues
 // the path. Emission reached by the continuation is weighted against the light
 // technique's density for the same direction, and the light sample against the
-// mixture's, so each light path is counted once in total.
+// mixture's, so each light path is counted once in total. The light
+// technique's density for the continuation is found at the vertex, from the
+// spherical rectangle the light sample set up there (leaf::SolidAngleSetup).
 Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops) {
   Vec3 radiance(0.0f);
   Vec3 throughput(1.0f);
   bool unweighted_emission = true;  // camera rays and specular bounces: no light sample competes
   float previous_pdf = 0.0f;        // the continuation's pdf at the last diffuse vertex
-  Vec3 previous_point(0.0f);
+  float previous_light_pdf = 0.0f;  // the emitters' density for the continuation's direction there
   int aimed_quad = -1;  // the quad the continuation was aimed at (DirectionSample::aimed_quad)
   float aimed_distance = 0.0f;
   for (int depth = 0; depth < scene.max_depth; ++depth) {
     Hit hit;
     const bool found = intersect_aimed(scene, ray, aimed_quad, aimed_distance, hit);
-    const int reached_quad = aimed_quad;  // the emitters' pdf below holds for a sliver aimed at
     aimed_quad = -1;
     if (!found) {
       radiance += throughput * scene.background;  // the background is not a light target
@@ -82,8 +85,7 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       if (front_face || m.two_sided) {
         float w = 1.0f;
         if (!unweighted_emission)
-          w = mis_weight(previous_pdf, plan.emitters.pdf(previous_point, ray.direction, reached_quad, aimed_distance),
-                         plan.heuristic);
+          w = mis_weight(previous_pdf, previous_light_pdf, plan.heuristic);
         radiance += throughput * m.emit * w;
       }
       break;
@@ -101,10 +103,12 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
 
     // The light sample. Its shadow ray is a path segment too: at the last
     // vertex max_depth allows there is none (the path would have one too many).
+    leaf::SolidAngleSetup setup{-1, {}};
     if (!plan.emitters.empty() && depth + 1 < scene.max_depth) {
       const std::uint32_t uc = rng.next_u32();
       const float u1 = rng.uniform(), u2 = rng.uniform();
-      const DirectionSample ls = plan.emitters.sample(origin, uc, u1, u2);
+      const DirectionSample ls = to_direction_sample(
+          leaf::sample_solid_angle_targets(plan.emitters, origin, static_cast<std::int32_t>(uc), u1, u2, true, setup));
       if (ls.none) {
         // Seen edge-on from here: no light sample, and the light pdf that the
         // material sample is weighed against is zero too.
@@ -145,7 +149,9 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);
     }
     previous_pdf = ds.pdf;
-    previous_point = origin;
+    if (depth + 1 < scene.max_depth)  // else the path ends before it could reach an emitter
+      previous_light_pdf = leaf::solid_angle_targets_pdf(plan.emitters, origin, ds.direction, ds.aimed_quad,
+                                                         ds.aimed_distance, true, &setup);
     unweighted_emission = false;
     ray = Ray{origin, ds.direction};
     aimed_quad = ds.aimed_quad;

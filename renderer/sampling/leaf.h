@@ -13,6 +13,23 @@ namespace pdflab {
 
 enum class MisHeuristic : std::uint8_t { Balance, Power };
 
+// A rectangle's frame for solid-angle sampling (leaf::spherical_rectangle),
+// computed once per quad in double (rectangle_axes, techniques.h): the corner
+// and the unit axes along u, along v and u x v, and the edge lengths.
+struct RectangleAxes {
+  double qx = 0, qy = 0, qz = 0;
+  double xx = 0, xy = 0, xz = 0;
+  double yx = 0, yy = 0, yz = 0;
+  double zx = 0, zy = 0, zz = 0;
+  Vec3 x{0.0f}, y{0.0f}, z{0.0f};  // the axes in float, to build directions
+  float ex = 0.0f, ey = 0.0f;
+  bool rectangle = false;  // else a parallelogram: area sampling
+  // A one-sided emitter: seen from behind (the side u x v points away from),
+  // its light cannot reach the point, so it is sampled there by area, the
+  // cheapest valid density (what it aims at is worth nothing from there).
+  bool one_sided = false;
+};
+
 namespace leaf {
 
 #define PDFLAB_LEAF inline

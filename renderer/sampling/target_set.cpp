@@ -1,5 +1,6 @@
 #include "renderer/sampling/target_set.h"
 
+#include "renderer/sampling/mixture.h"
 #include "renderer/sampling/techniques.h"
 
 #include <numbers>
@@ -24,33 +25,33 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
 
 float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip, int aimed_quad,
                              float aimed_t) const {
-  float sum = 0.0f;
-  if (solid_angle) {
-    for (const QuadEntry& e : quads)
-      if (e.quad != skip)
-        sum += e.probability * quad_solid_angle_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
-  } else {
-    for (const QuadEntry& e : quads)
-      if (e.quad != skip)
-        sum += e.probability * leaf::quad_area_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
-  }
+  float sum = 0.0f;  // an area set (solid-angle sets: leaf::solid_angle_targets_pdf)
+  for (const QuadEntry& e : quads)
+    if (e.quad != skip)
+      sum += e.probability * leaf::quad_area_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
   for (const SphereEntry& e : spheres)
     if (e.sphere != skip) sum += e.probability * sphere_cone_pdf(*e.sphere, origin, direction);
   return sum;
 }
 
 float TargetSet::pdf(const Vec3& origin, const Vec3& direction, int aimed_quad, float aimed_t) const {
+  if (solid_angle) return leaf::solid_angle_targets_pdf(*this, origin, direction, aimed_quad, aimed_t, true, nullptr);
   return pdf_without(origin, direction, nullptr, aimed_quad, aimed_t);
 }
 
 DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const {
+  if (solid_angle) {
+    leaf::SolidAngleSetup setup{-1, {}};
+    return to_direction_sample(
+        leaf::sample_solid_angle_targets(*this, origin, static_cast<std::int32_t>(u_choice), u1, u2, true, setup));
+  }
   if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at
   const int chosen = choice.sample(u_choice);
   DirectionSample ds;
   const int nq = static_cast<int>(quads.size());
   if (chosen < nq) {
     const QuadEntry& e = quads[chosen];
-    ds = solid_angle ? sample_quad_solid_angle(*e.quad, origin, u1, u2) : sample_quad_area(*e.quad, origin, u1, u2);
+    ds = sample_quad_area(*e.quad, origin, u1, u2);
     if (ds.none) return ds;
     ds.aimed_quad = e.index;
     ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.quad);
@@ -71,7 +72,9 @@ std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pic
   for (std::size_t i = 0; i < scene.quads.size(); ++i) {
     const Quad& q = scene.quads[i];
     if (!pick(Target{Target::Kind::Quad, static_cast<std::uint32_t>(i)})) continue;
-    set.quads.push_back({&q, 0.0f, static_cast<std::int32_t>(i)});
+    set.quads.push_back({&q, 0.0f, static_cast<std::int32_t>(i), rectangle_axes(q)});
+    const Material& m = scene.materials[q.material];
+    set.quads.back().axes.one_sided = m.type == MaterialType::DiffuseLight && !m.two_sided;
     quad_power.push_back(emitter_power(scene.materials[q.material], q.area));
   }
   for (std::size_t i = 0; i < scene.spheres.size(); ++i) {

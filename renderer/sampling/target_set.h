@@ -18,6 +18,7 @@ struct TargetSet {
     const Quad* quad;
     float probability;
     std::int32_t index;  // in Scene::quads (DirectionSample::aimed_quad)
+    RectangleAxes axes;  // for solid-angle sampling (leaf::spherical_rectangle)
   };
   struct SphereEntry {
     const Sphere* sphere;

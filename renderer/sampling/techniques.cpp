@@ -56,6 +56,22 @@ SphericalRectangle spherical_rectangle(const Quad& quad, const Vec3& origin) {
   return r;
 }
 
+RectangleAxes rectangle_axes(const Quad& quad) {
+  RectangleAxes a;
+  a.rectangle = quad_is_rectangle(quad);
+  const double ex = static_cast<double>(length(quad.u)), ey = static_cast<double>(length(quad.v));
+  const D3 x = to_d(quad.u) / ex, y = to_d(quad.v) / ey, z = dcross(x, y);
+  a.qx = quad.q.x, a.qy = quad.q.y, a.qz = quad.q.z;
+  a.xx = x.x, a.xy = x.y, a.xz = x.z;
+  a.yx = y.x, a.yy = y.y, a.yz = y.z;
+  a.zx = z.x, a.zy = z.y, a.zz = z.z;
+  a.x = Vec3(static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z));
+  a.y = Vec3(static_cast<float>(y.x), static_cast<float>(y.y), static_cast<float>(y.z));
+  a.z = Vec3(static_cast<float>(z.x), static_cast<float>(z.y), static_cast<float>(z.z));
+  a.ex = static_cast<float>(ex), a.ey = static_cast<float>(ey);
+  return a;
+}
+
 DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, float u1, float u2) {
   const SphericalRectangle r = spherical_rectangle(quad, origin);
   if (!r.usable) return sample_quad_area(quad, origin, u1, u2);

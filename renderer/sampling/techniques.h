@@ -103,6 +103,8 @@ inline bool quad_is_rectangle(const Quad& quad) {
 }
 
 SphericalRectangle spherical_rectangle(const Quad& quad, const Vec3& origin);
+// The quad's frame for the float set-up (leaf::spherical_rectangle), in double.
+RectangleAxes rectangle_axes(const Quad& quad);
 
 DirectionSample sample_quad_solid_angle(const Quad& quad, const Vec3& origin, float u1, float u2);
 // `aimed`: the direction is known to reach the quad at distance aimed_t (leaf::quad_area_pdf).
