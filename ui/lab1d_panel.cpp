@@ -280,12 +280,21 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
   }
   if (pick && s.typed) s.typed.reset();
   if (pick || f != s.integrand || p != s.pdf) s.select(f, p);
-  ImGui::SameLine();
-  if (ImGui::Button(s.running ? "Pause" : "Run")) s.running = !s.running;
-  ImGui::SameLine();
+  // The controls wrap onto the next row rather than run past the window's edge.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const auto button_width = [&](const char* label) { return ImGui::CalcTextSize(label).x + style.FramePadding.x * 2.0f; };
+  const auto same_line_if_fits = [&](float width) {
+    ImGui::SameLine();
+    if (ImGui::GetContentRegionAvail().x < width) ImGui::NewLine();
+  };
+  const char* run_label = s.running ? "Pause" : "Run";
+  same_line_if_fits(button_width(run_label));
+  if (ImGui::Button(run_label)) s.running = !s.running;
+  same_line_if_fits(button_width("Reset"));
   if (ImGui::Button("Reset")) s.reset();
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 7.0f);
+  const float slider_width = ImGui::GetFontSize() * 7.0f;
+  same_line_if_fits(slider_width + style.ItemInnerSpacing.x + ImGui::CalcTextSize("samples/frame").x);
+  ImGui::SetNextItemWidth(slider_width);
   ImGui::SliderInt("samples/frame", &s.samples_per_frame, 1, 4096, "%d", ImGuiSliderFlags_Logarithmic);
 
   if (!s.f_error.empty()) ImGui::TextColored(kRed, "%s", s.f_error.c_str());

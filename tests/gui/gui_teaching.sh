@@ -97,9 +97,10 @@ select_all() {
   xdotool keyup --window "$wid" ctrl
   sleep 0.15
 }
-# red_line FILE: the fraction of red pixels in the line under the lab's first
-# row, where a refused expression is named.
-red_line() { convert "$1" -crop 680x16+14+64 +repage -fx "r > 0.8 && g < 0.55 ? 1 : 0" -format "%[fx:mean]" info:; }
+# red_line FILE: the fraction of red pixels in the band under the lab's first
+# row, where a refused expression is named (one or two rows down: the row's
+# controls wrap in a narrow window).
+red_line() { convert "$1" -crop 680x40+14+60 +repage -fx "r > 0.8 && g < 0.55 ? 1 : 0" -format "%[fx:mean]" info:; }
 # The f(x) field, right of the drop-down in the lab's first row.
 xdotool mousemove 250 48 click 1
 sleep 0.2
@@ -111,7 +112,7 @@ sleep 1
 alive "$viewer" "a bad expression"
 shot lab_bad
 changed "$art/lab_later.png" "$art/lab_bad.png"
-awk -v r="$(red_line "$art/lab_bad.png")" 'BEGIN { exit !(r > 0.01) }' || fail "no message for a bad expression"
+awk -v r="$(red_line "$art/lab_bad.png")" 'BEGIN { exit !(r > 0.004) }' || fail "no message for a bad expression"
 xdotool mousemove 250 48 click 1
 sleep 0.2
 select_all
