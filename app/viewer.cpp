@@ -231,6 +231,7 @@ struct Viewer::Impl {
   FrameLayout lay_out(int fb_w, int fb_h);
   void draw_panel(const FrameLayout& l, ui::UiRequests& requests);
   void draw_overlays(const FrameLayout& l, ui::UiRequests& requests);
+  ImVec2 badges_corner{0.0f, 0.0f};  // this frame's image badges (draw_panel), kept clear by the legend
   void draw_quit_question();
   void apply_requests(const ui::UiRequests& requests);
   void draw_gl(const FrameLayout& l);
@@ -1119,9 +1120,10 @@ Viewer::Impl::FrameLayout Viewer::Impl::lay_out(int fb_w, int fb_h) {
 
 void Viewer::Impl::draw_panel(const FrameLayout& l, ui::UiRequests& requests) {
   const ImGuiIO& io = ImGui::GetIO();
+  badges_corner = ImVec2(0.0f, 0.0f);
   if (!settings.presentation) {
     ui::draw_side_panel(l.panel_width, io.DisplaySize.y, settings, panel, status, requests);
-    ui::draw_image_badges(settings, status);
+    badges_corner = ui::draw_image_badges(settings, status);
   } else if (now() - presentation_since < 3.0) {
     ui::draw_hint("Presentation mode: F11 or Esc leaves");
   }
@@ -1135,7 +1137,7 @@ void Viewer::Impl::draw_overlays(const FrameLayout& l, ui::UiRequests& requests)
   // Layers, the divider, the probe's cross: never over the panel, however far the image reaches.
   const ui::ImageRect& a = l.area_rect;
   ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(a.x, a.y), ImVec2(a.x + a.width, a.y + a.height));
-  ui::draw_image_overlays(l.image_rect, a, settings, measure, view_texture->id(), requests);
+  ui::draw_image_overlays(l.image_rect, a, settings, measure, view_texture->id(), requests, badges_corner);
   teaching->draw_ui(*session, l.image_fb, l.fb_h, framebuffer_scale, a.width, a.height);
   if (!settings.presentation) inspect(l.image_rect, a);
   else inspected.reset();

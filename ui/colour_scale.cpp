@@ -134,4 +134,24 @@ ColourScale difference_scale(double half_range) {
   return s;
 }
 
+std::vector<std::size_t> labels_that_fit(const std::vector<float>& centre, const std::vector<float>& width, float bar,
+                                         float gap) {
+  const std::size_t n = std::min(centre.size(), width.size());
+  std::vector<std::size_t> keep;
+  if (n == 0) return keep;
+  // A label's left edge, clamped so it stays on the bar as the drawing does.
+  const auto left = [&](std::size_t i) { return std::clamp(centre[i] - width[i] * 0.5f, 0.0f, std::max(0.0f, bar - width[i])); };
+  keep.push_back(0);
+  if (n == 1) return keep;
+  const float last_left = left(n - 1);
+  float right = left(0) + width[0];
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    if (left(i) < right + gap || left(i) + width[i] + gap > last_left) continue;
+    keep.push_back(i);
+    right = left(i) + width[i];
+  }
+  keep.push_back(n - 1);
+  return keep;
+}
+
 }  // namespace pdflab::ui

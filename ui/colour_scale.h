@@ -3,6 +3,7 @@
 #include "renderer/metrics/ticks.h"
 
 #include <array>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,12 @@ struct LegendTick {
   std::string label;
 };
 std::vector<LegendTick> legend_ticks(const ColourScale& scale);
+// Which of the labels, centred at `centre` (pixels along the bar) with widths
+// `width`, to draw so that none overlaps another: both ends always (clamped to
+// the bar's [0, bar] span), the inner ones left to right while they keep `gap`
+// from the last one drawn and from the end label. Returns their indices.
+std::vector<std::size_t> labels_that_fit(const std::vector<float>& centre, const std::vector<float>& width, float bar,
+                                         float gap);
 
 // The heat map's scale: relative standard error, logarithmic, 0.001 to 10.
 ColourScale relative_error_scale();

@@ -106,23 +106,34 @@ void draw_colour_bar(const ColourScale& scale, float width) {
   }
   dl->AddRect(p0, ImVec2(p0.x + width, p0.y + bar_h), IM_COL32(200, 200, 200, 160));
   const float label_y = p0.y + bar_h + 3.0f;
-  for (const LegendTick& t : legend_ticks(scale)) {
-    const float x = p0.x + width * static_cast<float>(t.position);
-    dl->AddLine(ImVec2(x, p0.y + bar_h - 3.0f), ImVec2(x, p0.y + bar_h + 2.0f), IM_COL32(230, 230, 230, 255));
-    const float tw = ImGui::CalcTextSize(t.label.c_str()).x;
-    const float tx = std::clamp(x - tw * 0.5f, p0.x - 2.0f, p0.x + width - tw + 2.0f);
-    dl->AddText(ImVec2(tx, label_y), IM_COL32(230, 230, 230, 255), t.label.c_str());
+  const std::vector<LegendTick> ticks = legend_ticks(scale);
+  std::vector<float> centre, text_width;
+  for (const LegendTick& t : ticks) {
+    const float x = width * static_cast<float>(t.position);
+    dl->AddLine(ImVec2(p0.x + x, p0.y + bar_h - 3.0f), ImVec2(p0.x + x, p0.y + bar_h + 2.0f), IM_COL32(230, 230, 230, 255));
+    centre.push_back(x);
+    text_width.push_back(ImGui::CalcTextSize(t.label.c_str()).x);
+  }
+  // On a narrow bar the inner labels that would run into each other are left out.
+  for (const std::size_t i : labels_that_fit(centre, text_width, width, ImGui::GetFontSize() * 0.4f)) {
+    const float tx = std::clamp(centre[i] - text_width[i] * 0.5f, 0.0f, std::max(0.0f, width - text_width[i]));
+    dl->AddText(ImVec2(p0.x + tx, label_y), IM_COL32(230, 230, 230, 255), ticks[i].label.c_str());
   }
   ImGui::Dummy(ImVec2(width, bar_h + 3.0f + ImGui::GetFontSize()));
 }
 
-void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, const MeasureState& m) {
+void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, const MeasureState& m,
+                        ImVec2 badges) {
   const ViewMode mode = settings.measure.view_mode;
   // Narrower than the area, so the window never pokes out of its left edge.
   const float width = std::min(area.width - 40.0f, ImGui::GetFontSize() * 18.0f);
   if (width < 80.0f) return;
-  // Top right of the image area, clear of the badges at its top left.
-  ImGui::SetNextWindowPos(ImVec2(area.x + area.width - 8.0f, area.y + 8.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+  // Top right of the image area; below the badges at its top left when the
+  // two would overlap.
+  const float right = area.x + area.width - 8.0f;
+  const float left = right - width - 2.0f * ImGui::GetStyle().WindowPadding.x;
+  const float top = badges.y > 0.0f && left < badges.x + 4.0f ? badges.y + 4.0f : area.y + 8.0f;
+  ImGui::SetNextWindowPos(ImVec2(right, top), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowBgAlpha(0.8f);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
@@ -508,14 +519,15 @@ void draw_nee_explanation() {
 }
 
 void draw_image_overlays(const ImageRect& image, const ImageRect& area, ViewerSettings& settings,
-                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests) {
+                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests,
+                         ImVec2 badges) {
   const ViewMode mode = settings.measure.view_mode;
   if (mode != ViewMode::Image) {
     if (measure.layer_ok && texture != 0 && image.width > 0.0f)
       ImGui::GetBackgroundDrawList()->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(texture)),
                                                ImVec2(image.x, image.y),
                                                ImVec2(image.x + image.width, image.y + image.height));
-    draw_legend_window(area, settings, measure);
+    draw_legend_window(area, settings, measure, badges);
   }
   if (settings.measure.show_plot) draw_convergence_window(area, settings, measure, requests);
 }

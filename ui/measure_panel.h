@@ -7,6 +7,8 @@
 
 #include <cstdint>
 
+#include <imgui.h>
+
 namespace pdflab::ui {
 
 // Where the image is drawn, in ImGui coordinates (top-left origin).
@@ -21,8 +23,11 @@ void draw_layer_controls(ViewerSettings& settings, const MeasureState* measure);
 // "How is this different?": nee-mis against the book's one-sample mixture.
 void draw_nee_explanation();
 // The false-colour layer (texture: ViewTexture::id, 0 for none), its legend,
-// and the convergence plot, over the image area.
+// and the convergence plot, over the image area. badges: the bottom-right
+// corner of the image badges (draw_image_badges), which the legend moves below
+// when the area is too narrow for both side by side.
 void draw_image_overlays(const ImageRect& image, const ImageRect& area, ViewerSettings& settings,
-                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests);
+                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests,
+                         ImVec2 badges = ImVec2(0.0f, 0.0f));
 
 }  // namespace pdflab::ui

@@ -510,20 +510,28 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
   ImGui::End();
 }
 
-void draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
+ImVec2 draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
   std::string text;
   if (status.showing_preview) text = "preview";
   else if (settings.paused) text = "paused";
   if (!settings.sampling.strategy().is_unbiased()) text += text.empty() ? "biased strategy" : "  |  biased strategy";
-  if (text.empty()) return;
+  if (text.empty()) return ImVec2(0.0f, 0.0f);
   const ImGuiViewport* vp = ImGui::GetMainViewport();
   ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + 8.0f, vp->Pos.y + 8.0f));
   ImGui::SetNextWindowBgAlpha(0.6f);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
-  if (ImGui::Begin("##badges", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text.c_str());
+  ImVec2 corner(0.0f, 0.0f);
+  if (ImGui::Begin("##badges", nullptr, flags)) {
+    ImGui::TextColored(kAmber, "%s", text.c_str());
+    // The window's size settles on its first frame; the text's own extent is
+    // known at once.
+    const ImVec2 pad = ImGui::GetStyle().WindowPadding;
+    corner = ImVec2(ImGui::GetItemRectMax().x + pad.x, ImGui::GetItemRectMax().y + pad.y);
+  }
   ImGui::End();
+  return corner;
 }
 
 void draw_hint(const char* text) {

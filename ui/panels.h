@@ -3,6 +3,8 @@
 // say what else they want in UiRequests; the viewer does the rest.
 #include "ui/settings.h"
 
+#include <imgui.h>
+
 namespace pdflab::ui {
 
 // Background of the side panel as RGB: the panel draws none, the viewer
@@ -17,8 +19,10 @@ void draw_side_panel(float width, float display_height, ViewerSettings& settings
 // Keys and what they do, centred over the image area.
 void draw_help_overlay(PanelState& state, float area_width, float area_height);
 
-// A short line over the image (preview, paused, biased), top-left of the image area.
-void draw_image_badges(const ViewerSettings& settings, const UiStatus& status);
+// A short line over the image (preview, paused, biased), top-left of the image
+// area. Returns the bottom-right corner of what it drew (0, 0 when nothing), so
+// the view legend can keep clear of it.
+ImVec2 draw_image_badges(const ViewerSettings& settings, const UiStatus& status);
 
 // A short line at the top centre of the display (a mode just entered).
 void draw_hint(const char* text);

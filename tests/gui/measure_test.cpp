@@ -158,6 +158,25 @@ TEST(ColourMaps, HeatMapLegendIsDecadesFromAThousandthToTen) {
   EXPECT_EQ(s.colour(10.0), sequential_colour(1.0));
 }
 
+TEST(ColourMaps, NarrowBarsLeaveOutInnerLabelsThatWouldOverlap) {
+  // Five labels 30 px wide at 0, 1/4, ... 1 of the bar, 4 px apart at least.
+  const std::vector<float> w(5, 30.0f);
+  const auto at = [](float bar) {
+    std::vector<float> c;
+    for (int i = 0; i < 5; ++i) c.push_back(bar * static_cast<float>(i) / 4.0f);
+    return c;
+  };
+  // Wide: every label fits.
+  EXPECT_EQ(labels_that_fit(at(400.0f), w, 400.0f, 4.0f), (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+  // 120 px: the ends sit at 0-30 and 90-120 (clamped); the middle label (45-75) clears both, the
+  // quarter labels (15-45, 75-105) do not.
+  EXPECT_EQ(labels_that_fit(at(120.0f), w, 120.0f, 4.0f), (std::vector<std::size_t>{0, 2, 4}));
+  // Too narrow for any inner label: the ends still show, both.
+  EXPECT_EQ(labels_that_fit(at(70.0f), w, 70.0f, 4.0f), (std::vector<std::size_t>{0, 4}));
+  EXPECT_EQ(labels_that_fit({5.0f}, {30.0f}, 10.0f, 4.0f), (std::vector<std::size_t>{0}));
+  EXPECT_TRUE(labels_that_fit({}, {}, 100.0f, 4.0f).empty());
+}
+
 TEST(ColourMaps, DifferenceLegendIsSymmetricAndNice) {
   EXPECT_DOUBLE_EQ(nice_ceiling(0.031), 0.05);
   EXPECT_DOUBLE_EQ(nice_ceiling(0.05), 0.05);
