@@ -102,10 +102,7 @@ float quad_solid_angle_pdf(const Quad& quad, const Vec3& origin, const Vec3& dir
   const float t = aimed ? aimed_t : quad_hit_distance(quad, origin, direction);
   if (t < 0.0f) return 0.0f;
   const SphericalRectangle r = spherical_rectangle(quad, origin);
-  if (!r.usable) {
-    const float cosine = std::fabs(dot(direction, quad.normal));
-    return t * t / (cosine * quad.area);
-  }
+  if (!r.usable) return leaf::quad_area_pdf_at(quad, direction, t);
   return static_cast<float>(1.0 / r.solid_angle);
 }
 
