@@ -221,7 +221,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     hit.point = ray.origin + ray.direction * closest;
     hit.normal = (hit.point - s.center) * (1.0f / s.radius);
     hit.material = s.material;
-    hit.error = leaf::sphere_hit_error(ray.origin, closest, hit.point, s.float_test ? s.radius : 0.0f);
+    hit.error = leaf::sphere_hit_error(ray.origin, closest, hit.point, s.float_radius());
     return true;
   }
   if (best_quad >= 0) {

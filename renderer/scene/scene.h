@@ -38,6 +38,8 @@ struct Sphere {
   // Intersected in float rather than double (leaf::sphere_hit_distance); set
   // by Scene::prepare for a sphere large against the scene.
   bool float_test = false;
+  // leaf::sphere_hit_error's `float_radius`: the radius where tested in float, else 0.
+  float float_radius() const { return float_test ? radius : 0.0f; }
 };
 
 // Builds a quad with its derived plane data (computed in double). Throws
