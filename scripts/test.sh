@@ -22,8 +22,10 @@ cmake --build --preset release -j"$jobs"
 ctest --preset release -j"$jobs" --timeout 600 -LE gui
 # The GUI tests drive a real (virtual) X server with xdotool, whose start-up and
 # focus can race, and xdotool is at times refused (BadWindow) by a live window;
-# they get up to four retries, everything else none.
-ctest --preset release --timeout 600 -L gui --repeat until-pass:5
+# they get up to four retries, everything else none. Each runs its own X
+# server and artifact folder, and most of its time is spent waiting for the
+# viewer, so they run side by side (apart from the rest of the suite).
+ctest --preset release -j"$jobs" --timeout 600 -L gui --repeat until-pass:5
 phase_done "Release build and suite"
 [ "${PDFLAB_QUICK:-0}" = 1 ] && exit 0
 
