@@ -25,16 +25,11 @@ shot panel "$panel_top"
 
 echo "== Esc with a drop-down open"
 xdotool mousemove "$((px + 120))" 43 click 1
-sleep 0.5
-shot dropdown "$panel_top"
-changed "$art/panel.png" "$art/dropdown.png" 0.03
+await_changed "$art/panel.png" dropdown "$panel_top" 0.03
 send_key Escape
-sleep 0.5
-alive "$viewer" "Esc with a drop-down open"
 xdotool mousemove 2 2
-sleep 0.3
-shot dropdown_closed "$panel_top"
-changed "$art/dropdown.png" "$art/dropdown_closed.png" 0.03
+await_changed "$art/dropdown.png" dropdown_closed "$panel_top" 0.03
+alive "$viewer" "Esc with a drop-down open"
 
 echo "== Esc while editing a text field"
 field="300x22+$((px + 8))+201"
@@ -43,17 +38,12 @@ xdotool mousemove "$((px + 200))" 212 click 1
 sleep 0.2
 send_key End
 xdotool type --window "$wid" "xyz"
-sleep 0.3
-shot field_typing "$field"
-changed "$art/field_before.png" "$art/field_typing.png" 0.005
+await_changed "$art/field_before.png" field_typing "$field" 0.005
 send_key Escape
-sleep 0.5
-alive "$viewer" "Esc in a text field"
 xdotool mousemove 2 2
-sleep 0.3
-shot field_after "$field"
 # Cancelled: the field shows the path it had (the caret gone).
-same "$art/field_before.png" "$art/field_after.png" 0.02
+await_same "$art/field_before.png" field_after "$field" 0.02
+alive "$viewer" "Esc in a text field"
 
 echo "== the pixel probe follows a strategy switch"
 # The image is centred left of the panel.
@@ -68,15 +58,11 @@ sleep 1
 legend="230x150+$((WIDTH - 250))+60"
 shot probe_cosine "$legend"
 send_key 2   # preset: light only
-sleep 1
-shot probe_light "$legend"
-changed "$art/probe_cosine.png" "$art/probe_light.png" 0.02
+await_changed "$art/probe_cosine.png" probe_light "$legend" 0.02
 shot probe_window
 send_key Escape  # leaves probe mode, closes the probe
-sleep 0.5
+await_changed "$art/probe_window.png" probe_left "" 0.02
 alive "$viewer" "Esc in probe mode"
-shot probe_left
-changed "$art/probe_window.png" "$art/probe_left.png" 0.02
 
 echo "== Ctrl+Q after a long unsaved render asks first"
 sleep 6
@@ -85,10 +71,8 @@ sleep 1
 alive "$viewer" "Ctrl+Q after an unsaved render (it must ask first)"
 shot asking
 send_key Escape   # cancel
-sleep 0.5
+await_changed "$art/asking.png" cancelled "" 0.02
 alive "$viewer" "Esc in the quit question"
-shot cancelled
-changed "$art/asking.png" "$art/cancelled.png" 0.02
 send_key ctrl+q
 sleep 1
 alive "$viewer" "Ctrl+Q (asking again)"

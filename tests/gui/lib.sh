@@ -96,6 +96,24 @@ same() {
   local d; d=$(rmse "$1" "$2"); echo "$(basename "$1") vs $(basename "$2"): RMSE $d"
   awk -v d="$d" -v f="${3:-0.01}" 'BEGIN { exit !(d <= f) }' || fail "$2 differs from $1"
 }
+# await_changed REF NAME GEOMETRY [FLOOR] / await_same REF NAME GEOMETRY
+# [CEILING]: shoots NAME (GEOMETRY "" for the whole window) until it differs
+# from / matches the capture REF, for up to 10 s, then checks it as changed /
+# same do. A loaded machine redraws late; these wait only as long as it takes.
+await_changed() { await_ changed "$@"; }
+await_same() { await_ same "$@"; }
+await_() {
+  local check=$1 ref=$2 name=$3 geometry=$4 limit=${5:-0.01} end=$((SECONDS + 10)) d
+  while :; do
+    shot "$name" "$geometry"
+    d=$(rmse "$ref" "$art/$name.png")
+    if [ "$check" = changed ]; then awk -v d="$d" -v f="$limit" 'BEGIN { exit !(d > f) }' && break
+    else awk -v d="$d" -v f="$limit" 'BEGIN { exit !(d <= f) }' && break; fi
+    [ "$SECONDS" -lt "$end" ] || break
+    sleep 0.2
+  done
+  "$check" "$ref" "$art/$name.png" "$limit"
+}
 # json_field FILE KEY...: a value of a JSON file (KEYs go down nested objects).
 json_field() {
   /usr/bin/python3 -c 'import json, sys
