@@ -5,6 +5,7 @@
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
+#include "renderer/metrics/statistics.h"
 #include "renderer/metrics/svg_plot.h"
 #include "renderer/metrics/weight_paths.h"
 #include "renderer/metrics/weight_prediction.h"
@@ -15,9 +16,11 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -80,8 +83,9 @@ double t_quantile(int dof) {
 // Every quantity here is positive, so the lower bound stops at 0.
 struct Interval {
   double mean = 0.0, half = 0.0;
-  double lo() const { return std::max(0.0, mean - half); }
-  double hi() const { return mean + half; }
+  double low = -1.0, high = -1.0;  // when set (>= 0): bounds that are not mean -+ half
+  double lo() const { return low >= 0.0 ? low : std::max(0.0, mean - half); }
+  double hi() const { return high >= 0.0 ? high : mean + half; }
 };
 Interval interval(const std::vector<double>& v) {
   Interval r;
@@ -94,6 +98,37 @@ Interval interval(const std::vector<double>& v) {
   const double sd = std::sqrt(ss / static_cast<double>(v.size() - 1));
   r.half = t_quantile(static_cast<int>(v.size()) - 1) * sd / std::sqrt(static_cast<double>(v.size()));
   return r;
+}
+
+// Efficiency from several runs: 1 / (V T), with V the mean over the runs of
+// relMSE x spp (the relative variance of one sample per pixel; each run's
+// relMSE x spp estimates it without bias whatever its spp, so a run slowed by
+// the machine's load counts alike) and T their mean seconds per sample. Not
+// the mean of the runs' own efficiencies: 1 / relMSE is convex, so that mean
+// sits above 1 / (mean relMSE), by much when relMSE is heavy-tailed (a mixture
+// with a small cosine share: most runs miss the rare bright paths and look
+// efficient, one in several meets them). The interval maps V's and T's
+// Student-t intervals through 1 / (V T), their relative half-widths combined.
+Interval pooled_efficiency(const std::vector<double>& relmse_spp, const std::vector<double>& seconds_per_sample) {
+  Interval e;
+  const Interval v = interval(relmse_spp), t = interval(seconds_per_sample);
+  if (!(v.mean > 0.0 && t.mean > 0.0)) {
+    e.mean = std::nan("");
+    return e;
+  }
+  e.mean = 1.0 / (v.mean * t.mean);
+  const double rel = std::hypot(v.half / v.mean, t.half / t.mean);
+  e.low = e.mean / (1.0 + rel);
+  e.high = rel < 1.0 ? e.mean / (1.0 - rel) : std::numeric_limits<double>::infinity();
+  e.half = 0.5 * (e.high - e.low);
+  return e;
+}
+
+// Every other value, from `first` (0 or 1): the two halves of a seed list.
+std::vector<double> half_of(const std::vector<double>& v, std::size_t first) {
+  std::vector<double> out;
+  for (std::size_t k = first; k < v.size(); k += 2) out.push_back(v[k]);
+  return out;
 }
 
 struct Run {
@@ -252,7 +287,9 @@ struct Row {
   bool unbiased = true;
   std::uint32_t spp = 0;  // the first seed's
   Interval seconds, relmse, efficiency, samples_per_second;
+  Interval relmse_spp;  // relMSE x spp: the relative variance of one sample per pixel
   Interval predicted;  // efficiency predicted from the pilot weight's runs
+  Interval predicted_relmse_spp;  // the relative variance the pilot's paths predict
   double predicted_rays_only = 0.0;  // the same with a cost of rays alone (no fixed cost per sample)
 };
 
@@ -268,55 +305,39 @@ struct BestFixed {
   double held_out = 0.0;  // 0 with a single seed
 };
 
-BestFixed fair_best_fixed(const std::vector<Row>& rows, const std::vector<std::vector<double>>& eff, int best) {
+BestFixed fair_best_fixed(const std::vector<Row>& rows, const std::vector<std::vector<double>>& relmse_spp,
+                          const std::vector<std::vector<double>>& per_sample, int best) {
   BestFixed out;
   if (best < 0) return out;
   const double centre = rows[static_cast<std::size_t>(best)].weight;
   out.fitted = rows[static_cast<std::size_t>(best)].efficiency.mean;
   out.fitted_weight = centre;
-  // Normal equations of y = c0 + c1 x + c2 x^2, x = w - centre.
-  double m[3][4] = {};
-  int points = 0;
-  double x_lo = 0.0, x_hi = 0.0;
+  // y = c0 + c1 x + c2 x^2 with x = w - centre, by least squares.
+  std::vector<double> xs, ys;
   for (const Row& r : rows) {
     const double x = r.weight - centre;
     if (!r.unbiased || std::fabs(x) > 0.2 + 1e-9 || !std::isfinite(r.efficiency.mean)) continue;
-    const double powers[3] = {1.0, x, x * x};
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) m[i][j] += powers[i] * powers[j];
-      m[i][3] += powers[i] * r.efficiency.mean;
-    }
-    x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
-    ++points;
+    xs.push_back(x);
+    ys.push_back(r.efficiency.mean);
   }
-  if (points >= 3) {
-    for (int c = 0; c < 3; ++c) {  // Gauss-Jordan; the matrix is positive definite for 3 distinct x
-      const double pivot = m[c][c];
-      if (!(std::fabs(pivot) > 0.0)) return out;
-      for (int j = 0; j < 4; ++j) m[c][j] /= pivot;
-      for (int i = 0; i < 3; ++i)
-        if (i != c)
-          for (int j = 3; j >= 0; --j) m[i][j] -= m[i][c] * m[c][j];
-    }
-    const double c0 = m[0][3], c1 = m[1][3], c2 = m[2][3];
-    auto at = [&](double x) { return c0 + c1 * x + c2 * x * x; };
-    double x_best = at(x_lo) > at(x_hi) ? x_lo : x_hi;
-    if (c2 < 0.0) x_best = std::clamp(-c1 / (2.0 * c2), x_lo, x_hi);
+  if (const std::optional<std::vector<double>> c = stats::polynomial_fit(xs, ys, 2)) {
+    auto at = [&](double x) { return (*c)[0] + (*c)[1] * x + (*c)[2] * x * x; };
+    const auto [x_lo, x_hi] = std::minmax_element(xs.begin(), xs.end());
+    double x_best = at(*x_lo) > at(*x_hi) ? *x_lo : *x_hi;
+    if ((*c)[2] < 0.0) x_best = std::clamp(-(*c)[1] / (2.0 * (*c)[2]), *x_lo, *x_hi);
     if (at(x_best) > 0.0) out.fitted = at(x_best), out.fitted_weight = centre + x_best;
   }
-  const std::size_t seeds = eff.empty() ? 0 : eff[0].size();
+  const std::size_t seeds = relmse_spp.empty() ? 0 : relmse_spp[0].size();
   if (seeds >= 2) {
-    auto half_mean = [&](std::size_t row, std::size_t half) {
-      double sum = 0.0;
-      int n = 0;
-      for (std::size_t k = half; k < eff[row].size(); k += 2) sum += eff[row][k], ++n;
-      return n > 0 ? sum / n : 0.0;
+    auto half_efficiency = [&](std::size_t row, std::size_t half) {
+      const double e = pooled_efficiency(half_of(relmse_spp[row], half), half_of(per_sample[row], half)).mean;
+      return std::isfinite(e) ? e : 0.0;
     };
     for (std::size_t half = 0; half < 2; ++half) {
       std::size_t chosen = static_cast<std::size_t>(best);
       for (std::size_t i = 0; i < rows.size(); ++i)
-        if (rows[i].unbiased && half_mean(i, half) > half_mean(chosen, half)) chosen = i;
-      out.held_out += 0.5 * half_mean(chosen, 1 - half);
+        if (rows[i].unbiased && half_efficiency(i, half) > half_efficiency(chosen, half)) chosen = i;
+      out.held_out += 0.5 * half_efficiency(chosen, 1 - half);
     }
   }
   return out;
@@ -328,7 +349,15 @@ BestFixed fair_best_fixed(const std::vector<Row>& rows, const std::vector<std::v
 constexpr std::uint32_t kPredictionSpp = 256;
 constexpr std::uint64_t kPredictionPaths = std::uint64_t{1} << 19;
 
+// The machine's one-minute load average (-1 when unknown): the sweeps' figures
+// are only as steady as the machine they ran on.
+double load_average() {
+  double load[1] = {-1.0};
+  return ::getloadavg(load, 1) == 1 ? load[0] : -1.0;
+}
+
 std::string num(double v) {
+  if (v == std::numeric_limits<double>::infinity()) return "inf";  // an interval's unbounded end
   if (!std::isfinite(v)) return "";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", v);
@@ -385,14 +414,15 @@ int run_sweep(const SweepOptions& o) {
 
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const bool show_progress = !o.quiet && tty;
+  const double load_at_start = load_average();
   // Seed by seed, every weight (and auto weight) in turn: on a machine whose
   // speed drifts, each weight's runs are spread over the whole sweep, so the
   // drift falls on all weights alike instead of on a few.
   const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
   std::size_t done_runs = 0;
-  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), eff(rows.size()), sps(rows.size()),
+  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), relspp(rows.size()), sps(rows.size()),
       per_sample(rows.size());
-  std::vector<double> auto_eff, auto_rel, auto_sec, auto_offset;
+  std::vector<double> auto_relspp, auto_per_sample, auto_rel, auto_sec, auto_offset;
   std::vector<std::vector<double>> auto_weights;
   for (int k = 0; k < o.seeds; ++k) {
     for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -417,31 +447,37 @@ int run_sweep(const SweepOptions& o) {
       }
       seconds[i].push_back(run.seconds);
       rel[i].push_back(run.relmse);
-      eff[i].push_back(run.efficiency);
       sps[i].push_back(run.samples_per_second);
-      if (run.spp > 0) per_sample[i].push_back(run.seconds / run.spp);
+      if (run.spp > 0) {
+        relspp[i].push_back(run.relmse * run.spp);
+        per_sample[i].push_back(run.seconds / run.spp);
+      }
       if (!o.quiet && !tty)
-        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g\n", label, run.spp, run.seconds,
-                     run.relmse, run.efficiency);
+        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g, load %.2f\n", label, run.spp,
+                     run.seconds, run.relmse, run.efficiency, load_average());
     }
     if (!o.auto_weight) continue;
     char label[64];
     std::snprintf(label, sizeof label, "[auto] seed %d/%d", k + 1, o.seeds);
     const AutoRun a = render_auto(scene, family, mixture_family, seeds[static_cast<std::size_t>(k)], o, reference,
                                   label, show_progress);
-    auto_eff.push_back(a.run.efficiency);
+    if (a.run.spp > 0) {
+      auto_relspp.push_back(a.run.relmse * a.run.spp);
+      auto_per_sample.push_back(a.run.seconds / a.run.spp);
+    }
     auto_rel.push_back(a.run.relmse);
     auto_sec.push_back(a.run.seconds);
     auto_weights.push_back(a.weights);
     auto_offset.push_back(a.cost.offset());
     if (!o.quiet && !tty)
-      std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting), relMSE %.4g, efficiency %.4g\n", label, a.run.spp,
-                   a.run.seconds, a.replay_seconds, a.run.relmse, a.run.efficiency);
+      std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting), relMSE %.4g, efficiency %.4g, load %.2f\n", label,
+                   a.run.spp, a.run.seconds, a.replay_seconds, a.run.relmse, a.run.efficiency, load_average());
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     rows[i].seconds = interval(seconds[i]);
     rows[i].relmse = interval(rel[i]);
-    rows[i].efficiency = interval(eff[i]);
+    rows[i].relmse_spp = interval(relspp[i]);
+    rows[i].efficiency = pooled_efficiency(relspp[i], per_sample[i]);
     rows[i].samples_per_second = interval(sps[i]);
   }
   // The cost model (weight_prediction.h): every row's measured seconds per
@@ -467,7 +503,8 @@ int run_sweep(const SweepOptions& o) {
   if (cost_model.per_ray > 0.0)
     for (WeightPrediction& p : predictions) apply_cost_model(p, cost_model);
 
-  const Interval auto_efficiency = interval(auto_eff), auto_relmse = interval(auto_rel),
+  const Interval auto_relspp_interval = interval(auto_relspp);
+  const Interval auto_efficiency = pooled_efficiency(auto_relspp, auto_per_sample), auto_relmse = interval(auto_rel),
                  auto_seconds = interval(auto_sec);
   if (show_progress) std::fputc('\n', stderr);
 
@@ -491,34 +528,84 @@ int run_sweep(const SweepOptions& o) {
       ++band_hi;
   }
   const double best_efficiency = best >= 0 ? rows[static_cast<std::size_t>(best)].efficiency.mean : 0.0;
-  const BestFixed fair = fair_best_fixed(rows, eff, best);
+  const BestFixed fair = fair_best_fixed(rows, relspp, per_sample, best);
 
-  // The prediction on each row's weight and on the fine grid, over the pilot's seeds.
-  std::vector<double> predicted_curve(grid.size(), 0.0), predicted_best;
+  // The prediction on each row's weight and on the fine grid, pooled over the
+  // pilot's seeds as the measured rows are (not the mean of each seed's
+  // efficiency): the mean relative variance and the mean rays at each weight,
+  // priced by the cost model; `rays_only` by the pilot's time per ray.
+  const double pilot_seconds = pilot >= 0 ? row_seconds_per_sample[static_cast<std::size_t>(pilot)] : std::nan("");
+  std::vector<double> predicted_var(grid.size(), 0.0), predicted_rays(grid.size(), 0.0),
+      predicted_curve(grid.size(), 0.0), rays_only_curve(grid.size(), 0.0), predicted_best;
+  double pilot_rays = 0.0;
   for (const WeightPrediction& p : predictions) {
-    for (std::size_t g = 0; g < grid.size(); ++g) predicted_curve[g] += p.efficiency[g] / static_cast<double>(predictions.size());
+    const double n = static_cast<double>(predictions.size());
+    for (std::size_t g = 0; g < grid.size(); ++g) predicted_var[g] += p.relative_variance[g] / n, predicted_rays[g] += p.cost[g] / n;
+    pilot_rays += p.sampling_cost / n;
     if (p.best >= 0) predicted_best.push_back(p.best_weight());
   }
-  double predicted_max_row = 0.0;
+  auto inverse = [](double d) { return std::isfinite(d) && d > 0.0 ? 1.0 / d : 0.0; };
+  int predicted_top = -1;  // the pooled curve's best, inside the defensive floor
+  double predicted_peak = 0.0;  // its maximum over the sweep's range, the measured peak's counterpart
+  for (std::size_t g = 0; g < grid.size() && !predictions.empty(); ++g) {
+    predicted_curve[g] = inverse(predicted_var[g] * cost_model.seconds(predicted_rays[g]));
+    rays_only_curve[g] = inverse(predicted_var[g] * pilot_seconds * predicted_rays[g] / pilot_rays);
+    if (defended_weight(grid[g]) == grid[g] &&
+        (predicted_top < 0 || predicted_curve[g] > predicted_curve[static_cast<std::size_t>(predicted_top)]))
+      predicted_top = static_cast<int>(g);
+    if (grid[g] >= weights.front() - 1e-9 && grid[g] <= weights.back() + 1e-9)
+      predicted_peak = std::max(predicted_peak, predicted_curve[g]);
+  }
+  if (predicted_top >= 0 && !(predicted_curve[static_cast<std::size_t>(predicted_top)] > 0.0)) predicted_top = -1;
   for (Row& r : rows) {
     if (predictions.empty()) {
-      r.predicted.mean = r.predicted_rays_only = std::nan("");
+      r.predicted.mean = r.predicted_rays_only = r.predicted_relmse_spp.mean = std::nan("");
       continue;
     }
+    const std::size_t g = grid_index(r.weight);
     std::vector<double> values;
-    for (const WeightPrediction& p : predictions) values.push_back(p.efficiency[grid_index(r.weight)]);
-    r.predicted = interval(values);
-    r.predicted_rays_only = 0.0;
-    for (const WeightPrediction& p : rays_only)
-      r.predicted_rays_only += p.efficiency[grid_index(r.weight)] / static_cast<double>(rays_only.size());
-    if (r.unbiased) predicted_max_row = std::max(predicted_max_row, r.predicted.mean);
+    for (const WeightPrediction& p : predictions) values.push_back(p.relative_variance[g]);
+    r.predicted_relmse_spp = interval(values);
+    const double seconds_here = cost_model.seconds(predicted_rays[g]);
+    r.predicted.mean = predicted_curve[g];
+    r.predicted.low = inverse(r.predicted_relmse_spp.hi() * seconds_here);
+    r.predicted.high = r.predicted_relmse_spp.lo() > 0.0 ? inverse(r.predicted_relmse_spp.lo() * seconds_here)
+                                                          : std::numeric_limits<double>::infinity();
+    r.predicted_rays_only = rays_only_curve[g];
   }
-  const Interval predicted_optimum = interval(predicted_best);
+  Interval predicted_optimum = interval(predicted_best);
+  predicted_optimum.mean = predicted_top >= 0 ? grid[static_cast<std::size_t>(predicted_top)] : std::nan("");
+
+  // The Must-show comparison: the predicted curve over its peak against the
+  // measured one over its fitted peak, at each row in [0.1, 0.9]; the largest
+  // gap |predicted / measured - 1|, over all those rows and over those where
+  // the measured curve is at least 0.3 of its peak (below that, a few rare
+  // paths decide the measured value); and at how many rows the prediction
+  // (scaled to the measured peak) lies inside the measured interval.
+  struct Gap {
+    double value = -1.0, at = -1.0;
+    void take(double v, double w) {
+      if (v > value) value = v, at = w;
+    }
+  } gap_all, gap_high;
+  int gap_inside = 0, gap_rows = 0;
+  for (const Row& r : rows) {
+    if (!r.unbiased || r.weight < 0.1 - 1e-9 || r.weight > 0.9 + 1e-9 || !(fair.fitted > 0.0) ||
+        !(predicted_peak > 0.0) || !std::isfinite(r.predicted.mean) || !(r.efficiency.mean > 0.0))
+      continue;
+    const double measured = r.efficiency.mean / fair.fitted, predicted = r.predicted.mean / predicted_peak;
+    const double gap = std::fabs(predicted / measured - 1.0);
+    ++gap_rows;
+    if (predicted * fair.fitted >= r.efficiency.lo() && predicted * fair.fitted <= r.efficiency.hi()) ++gap_inside;
+    gap_all.take(gap, r.weight);
+    if (measured >= 0.3) gap_high.take(gap, r.weight);
+  }
   std::string csv =
       "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
       "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
       "predicted_efficiency_lo,predicted_efficiency_hi,predicted_relative_efficiency,best,in_best_interval,rays_per_sample,seconds_per_sample,"
-      "model_seconds_per_sample,predicted_efficiency_rays_only\n";
+      "model_seconds_per_sample,predicted_efficiency_rays_only,relmse_per_sample,relmse_per_sample_lo,relmse_per_sample_hi,"
+      "predicted_relmse_per_sample\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const int idx = static_cast<int>(i);
@@ -530,12 +617,13 @@ int run_sweep(const SweepOptions& o) {
            num(r.samples_per_second.mean) + "," + num(r.samples_per_second.lo()) + "," +
            num(r.samples_per_second.hi()) + "," + num(r.predicted.mean) + "," + num(r.predicted.lo()) + "," +
            num(r.predicted.hi()) + "," +
-           num(predicted_max_row > 0 && r.unbiased ? r.predicted.mean / predicted_max_row : std::nan("")) + "," +
+           num(predicted_peak > 0 && r.unbiased ? r.predicted.mean / predicted_peak : std::nan("")) + "," +
            (idx == best ? "1" : "0") + "," +
            (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "," + num(row_rays[i]) + "," +
            num(row_seconds_per_sample[i]) + "," +
            num(std::isfinite(row_rays[i]) ? cost_model.seconds(row_rays[i]) : std::nan("")) + "," +
-           num(r.predicted_rays_only) + "\n";
+           num(r.predicted_rays_only) + "," + num(r.relmse_spp.mean) + "," + num(r.relmse_spp.lo()) + "," +
+           num(r.relmse_spp.hi()) + "," + num(r.predicted_relmse_spp.mean) + "\n";
   }
 
   if (o.auto_weight) {
@@ -545,7 +633,9 @@ int run_sweep(const SweepOptions& o) {
            num(auto_seconds.mean) + "," + num(auto_relmse.mean) + "," + num(auto_relmse.lo()) + "," +
            num(auto_relmse.hi()) + "," + num(auto_efficiency.mean) + "," + num(auto_efficiency.lo()) + "," +
            num(auto_efficiency.hi()) + "," +
-           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0,,,,\n";
+           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0,,,,," +
+           num(auto_relspp_interval.mean) + "," + num(auto_relspp_interval.lo()) + "," + num(auto_relspp_interval.hi()) +
+           ",\n";
   }
   std::string plot;
   if (!o.plot.empty()) {
@@ -598,7 +688,7 @@ int run_sweep(const SweepOptions& o) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     char eff_text[64];
-    std::snprintf(eff_text, sizeof eff_text, "%.4g +- %.2g", r.efficiency.mean, r.efficiency.half);
+    std::snprintf(eff_text, sizeof eff_text, "%.4g [%.3g, %.3g]", r.efficiency.mean, r.efficiency.lo(), r.efficiency.hi());
     std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %11.4g %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(),
                 r.spp, r.relmse.mean, eff_text, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
                 r.predicted.mean, r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
@@ -627,8 +717,8 @@ int run_sweep(const SweepOptions& o) {
                 fair.held_out > 0 ? 100.0 * auto_efficiency.mean / fair.held_out : 0.0);
     for (double v : auto_offset) std::printf(" %.2f", v);
     std::printf("\n");
-    std::printf("auto weight: efficiency %.4g +- %.2g, %.0f%% of the best fixed weight's; weights per pass:",
-                auto_efficiency.mean, auto_efficiency.half,
+    std::printf("auto weight: efficiency %.4g [%.3g, %.3g], %.0f%% of the best fixed weight's; weights per pass:",
+                auto_efficiency.mean, auto_efficiency.lo(), auto_efficiency.hi(),
                 best_efficiency > 0 ? 100.0 * auto_efficiency.mean / best_efficiency : 0.0);
     for (const auto& h : auto_weights) {
       std::printf(" ");
@@ -637,12 +727,18 @@ int run_sweep(const SweepOptions& o) {
     std::printf("\n");
   }
   if (!predictions.empty())
-    std::printf("predicted best weight (from the paths at %.3g, %zu seeds): %.3g +- %.2g\n",
+    std::printf("predicted best weight (from the paths at %.3g, %zu seeds pooled): %.3g; each seed's alone: %.3g +- %.2g\n",
                 rows[static_cast<std::size_t>(pilot)].weight, predictions.size(), predicted_optimum.mean,
-                predicted_optimum.half);
+                interval(predicted_best).mean, predicted_optimum.half);
+  if (gap_rows > 0)
+    std::printf("predicted relative efficiency against measured, %d weights in [0.1, 0.9]: largest gap %.0f%% (at %.3g); "
+                "%.0f%% (at %.3g) where measured is at least 0.3 of its peak; inside the measured 95%% interval at %d of %d\n",
+                gap_rows, 100.0 * gap_all.value, gap_all.at, 100.0 * std::max(0.0, gap_high.value), gap_high.at,
+                gap_inside, gap_rows);
   else
     std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
                 1.0 - kDefensiveFloor);
+  std::printf("load average (1 min): %.2f at the start, %.2f at the end\n", load_at_start, load_average());
   return 0;
 }
 

@@ -7,6 +7,8 @@
 // from one run of a noisy machine.
 //
 //   bench_memory [--binary PDFLAB] [--compare OLD_PDFLAB] [--sizes 600,1200,1800,2400] [--rounds R]
+#include "renderer/metrics/statistics.h"
+
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -16,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -45,25 +48,6 @@ long long peak_rss(const std::string& binary, const std::vector<std::string>& ar
   rusage usage{};
   if (::wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
   return static_cast<long long>(usage.ru_maxrss) * 1024;  // kilobytes on Linux
-}
-
-struct Fit {
-  double slope = 0.0, intercept = 0.0;
-};
-
-Fit least_squares(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = static_cast<double>(x.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    sx += x[i];
-    sy += y[i];
-    sxx += x[i] * x[i];
-    sxy += x[i] * y[i];
-  }
-  Fit f;
-  f.slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  f.intercept = (sy - f.slope * sx) / n;
-  return f;
 }
 
 struct Kind {
@@ -132,9 +116,14 @@ int main(int argc, char** argv) {
         if (label == "this") ++failures;
         continue;
       }
-      const Fit f = least_squares(x, y);
-      std::printf("| %s | %s | %.1f | %.1f | %.0f |\n", label.c_str(), kind.name.c_str(), f.slope,
-                  f.intercept / (1 << 20), y.back() / (1 << 20));
+      const std::optional<std::vector<double>> line = pdflab::stats::polynomial_fit(x, y, 1);
+      if (!line) {
+        std::printf("| %s | %s | (sizes give no line) | | |\n", label.c_str(), kind.name.c_str());
+        if (label == "this") ++failures;
+        continue;
+      }
+      std::printf("| %s | %s | %.1f | %.1f | %.0f |\n", label.c_str(), kind.name.c_str(), (*line)[1],
+                  (*line)[0] / (1 << 20), y.back() / (1 << 20));
       std::fflush(stdout);
     }
   }

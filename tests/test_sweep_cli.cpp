@@ -149,6 +149,14 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
     EXPECT_GE(number(rows[i], "relmse_hi"), number(rows[i], "relmse"));
     EXPECT_LE(number(rows[i], "efficiency_lo"), number(rows[i], "efficiency"));
     EXPECT_GE(number(rows[i], "efficiency_hi"), number(rows[i], "efficiency"));
+    // Pooled over the seeds: 1 / (mean relMSE x spp * mean seconds per sample),
+    // not the mean of each run's efficiency.
+    EXPECT_NEAR(number(rows[i], "efficiency"),
+                1.0 / (number(rows[i], "relmse_per_sample") * number(rows[i], "seconds_per_sample")),
+                1e-4 * number(rows[i], "efficiency"));
+    EXPECT_NEAR(number(rows[i], "relmse_per_sample"), number(rows[i], "relmse") * 4.0,
+                1e-4 * number(rows[i], "relmse_per_sample"));  // 4 spp every run
+    EXPECT_LE(number(rows[i], "relmse_per_sample_lo"), number(rows[i], "relmse_per_sample"));
     if (rows[i].at("best") == "1") best = static_cast<int>(i), ++bests;
     // Every path traces at least its camera ray; the cost model gives every row a time.
     EXPECT_GE(number(rows[i], "rays_per_sample"), 1.0) << i;

@@ -139,4 +139,63 @@ ChiSquareResult chi_square_test(const std::vector<std::uint64_t>& observed, cons
   return r;
 }
 
+std::optional<std::vector<double>> least_squares(std::span<const double> design, std::size_t columns,
+                                                 std::span<const double> y) {
+  const std::size_t n = y.size(), k = columns;
+  if (k == 0 || n < k || design.size() != n * k) return std::nullopt;
+  for (double v : design)
+    if (!std::isfinite(v)) return std::nullopt;
+  for (double v : y)
+    if (!std::isfinite(v)) return std::nullopt;
+  // Columns scaled to unit length: the normal equations of x and x^2 with x in
+  // the thousands would otherwise span many orders of magnitude.
+  std::vector<double> scale(k, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < k; ++j) scale[j] += design[i * k + j] * design[i * k + j];
+  for (double& s : scale) {
+    if (!(s > 0.0)) return std::nullopt;  // a zero column
+    s = 1.0 / std::sqrt(s);
+  }
+  // [X^T X | X^T y] of the scaled columns.
+  std::vector<double> m(k * (k + 1), 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t r = 0; r < k; ++r) {
+      const double xr = design[i * k + r] * scale[r];
+      for (std::size_t c = 0; c < k; ++c) m[r * (k + 1) + c] += xr * design[i * k + c] * scale[c];
+      m[r * (k + 1) + k] += xr * y[i];
+    }
+  // Gauss-Jordan with partial pivoting. The scaled matrix has a unit diagonal,
+  // so a pivot this small means the columns are (nearly) dependent.
+  constexpr double kSingular = 1e-12;
+  for (std::size_t c = 0; c < k; ++c) {
+    std::size_t pivot = c;
+    for (std::size_t r = c + 1; r < k; ++r)
+      if (std::fabs(m[r * (k + 1) + c]) > std::fabs(m[pivot * (k + 1) + c])) pivot = r;
+    if (!(std::fabs(m[pivot * (k + 1) + c]) > kSingular)) return std::nullopt;
+    if (pivot != c)
+      for (std::size_t j = 0; j <= k; ++j) std::swap(m[c * (k + 1) + j], m[pivot * (k + 1) + j]);
+    const double p = m[c * (k + 1) + c];
+    for (std::size_t j = 0; j <= k; ++j) m[c * (k + 1) + j] /= p;
+    for (std::size_t r = 0; r < k; ++r) {
+      if (r == c) continue;
+      const double f = m[r * (k + 1) + c];
+      for (std::size_t j = 0; j <= k; ++j) m[r * (k + 1) + j] -= f * m[c * (k + 1) + j];
+    }
+  }
+  std::vector<double> out(k);
+  for (std::size_t j = 0; j < k; ++j) out[j] = m[j * (k + 1) + k] * scale[j];
+  return out;
+}
+
+std::optional<std::vector<double>> polynomial_fit(std::span<const double> x, std::span<const double> y, int degree) {
+  if (degree < 0 || x.size() != y.size()) return std::nullopt;
+  const std::size_t k = static_cast<std::size_t>(degree) + 1;
+  std::vector<double> design(x.size() * k);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    double power = 1.0;
+    for (std::size_t j = 0; j < k; ++j, power *= x[i]) design[i * k + j] = power;
+  }
+  return least_squares(design, k, y);
+}
+
 }  // namespace pdflab::stats

@@ -2,8 +2,12 @@
 // Small statistics toolkit for the statistical tests and the viewer's in-app
 // chi-square check: chi-square p-values
 // (regularised incomplete gamma), multiple-testing corrections and normal
-// quantiles. Double precision throughout; nothing here is on a hot path.
+// quantiles, and linear least squares. Double precision throughout; nothing
+// here is on a hot path.
+#include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <vector>
 
 namespace pdflab::stats {
@@ -42,5 +46,20 @@ struct ChiSquareResult {
 // regular cell if the pool itself stays below the minimum).
 ChiSquareResult chi_square_test(const std::vector<std::uint64_t>& observed, const std::vector<double>& expected,
                                 double min_expected = 5.0);
+
+// Linear least squares: the coefficients c minimising
+// sum_i (y_i - sum_j c_j X_ij)^2, with the design matrix X given row by row
+// (`columns` values per point, so design.size() == y.size() * columns). Solved
+// through the normal equations with the columns scaled to unit length and
+// partial pivoting (the fits here have two or three columns). nullopt when the
+// points do not determine the coefficients: fewer points than columns, a
+// column that is zero or a combination of the others, or a size mismatch.
+std::optional<std::vector<double>> least_squares(std::span<const double> design, std::size_t columns,
+                                                 std::span<const double> y);
+
+// The polynomial y = c_0 + c_1 x + ... + c_degree x^degree of least squares
+// (coefficients from c_0 up); nullopt as for least_squares (for example fewer
+// distinct x than coefficients).
+std::optional<std::vector<double>> polynomial_fit(std::span<const double> x, std::span<const double> y, int degree);
 
 }  // namespace pdflab::stats

@@ -211,7 +211,7 @@ WeightPrediction predict_image_wide(const WeightPredictor& predictor, const std:
 }
 
 double AutoWeight::pass_share(int pass) {
-  static constexpr double kShare[kPasses] = {1.0 / 16, 1.0 / 16, 1.0 / 8, 1.0 / 4, 1.0 / 2};
+  static constexpr double kShare[kPasses] = {1.0 / 32, 3.0 / 32, 1.0 / 8, 1.0 / 4, 1.0 / 2};
   return pass >= 0 && pass < kPasses ? kShare[pass] : 0.0;
 }
 

@@ -102,12 +102,13 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
 // would correlate the weight with those samples' noise, and the sum would no
 // longer be unbiased.)
 //
-// The schedule: a run of kPasses passes taking 1/16, 1/16, 1/8, 1/4 and 1/2 of
+// The schedule: a run of kPasses passes taking 1/32, 3/32, 1/8, 1/4 and 1/2 of
 // its time (or samples), the first at `first`. The first pass is short because
-// its weight is a guess; after each pass but the last a few of its samples per
-// pixel are replayed for the prediction (replay_samples: about 1/32 of the
-// pass, 1 to 8: predicting costs several per cent of a short run, less of a
-// long one), and the next weight is the best of the passes' predicted curves
+// its weight is a guess (at 1/16 it cost up to 3 % of the run on the
+// aluminium box, whose 0.5 has half the best weight's efficiency); after each
+// pass but the last a few more samples per pixel are traced for the
+// prediction (replay_samples: about 1/32 of the pass, 1 to 8: predicting
+// costs several per cent of a short run, less of a long one), and the next weight is the best of the passes' predicted curves
 // so far, each counted by its number of paths.
 //
 // The time a weight costs comes from a CostModel (weight_prediction.h) fitted

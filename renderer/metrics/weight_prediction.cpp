@@ -1,10 +1,12 @@
 #include "renderer/metrics/weight_prediction.h"
 
 #include "renderer/error.h"
+#include "renderer/metrics/statistics.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace pdflab {
 
@@ -148,18 +150,14 @@ CostModel CostFit::fit(double prior_offset, double min_spread) const {
   for (std::size_t i = 0; i < x_.size(); ++i) mx += x_[i] / n, my += y_[i] / n;
   const auto [lo, hi] = std::minmax_element(x_.begin(), x_.end());
   if (x_.size() >= 2 && *hi - *lo >= min_spread * mx) {
-    double sxx = 0.0, sxy = 0.0;
-    for (std::size_t i = 0; i < x_.size(); ++i) sxx += (x_[i] - mx) * (x_[i] - mx), sxy += (x_[i] - mx) * (y_[i] - my);
-    const double slope = sxy / sxx;
-    if (slope > 0.0) {
+    const std::optional<std::vector<double>> line = stats::polynomial_fit(x_, y_, 1);
+    if (line && (*line)[1] > 0.0) {
       m.fitted = true;
-      m.per_ray = slope;
-      m.per_sample = my - slope * mx;
+      m.per_sample = (*line)[0];
+      m.per_ray = (*line)[1];
       if (m.per_sample < 0.0) {  // no negative fixed cost: all of it per ray, through the origin
-        double xx = 0.0, xy = 0.0;
-        for (std::size_t i = 0; i < x_.size(); ++i) xx += x_[i] * x_[i], xy += x_[i] * y_[i];
         m.per_sample = 0.0;
-        m.per_ray = xy / xx;
+        m.per_ray = (*stats::least_squares(x_, 1, y_))[0];  // x > 0: determined
       }
       return m;
     }
