@@ -232,6 +232,9 @@ int main(int argc, char** argv) {
   add_roulette_option(sweep, so.roulette_depth);
   sweep->add_flag("--auto", so.auto_weight,
                   "Also render with auto weight (chosen between passes from the prediction) and compare");
+  sweep->add_flag("--cpu-time", so.cpu_time,
+                  "Price each run by its CPU time rather than the wall clock (runs still stop by the wall clock); "
+                  "for a machine shared with other work");
 
   try {
     app.parse(argc, argv);

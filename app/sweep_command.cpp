@@ -12,6 +12,8 @@
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
+#include <sys/resource.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -134,21 +136,32 @@ std::vector<double> half_of(const std::vector<double>& v, std::size_t first) {
 struct Run {
   std::uint32_t spp = 0;
   double seconds = 0.0, relmse = 0.0, efficiency = 0.0, samples_per_second = 0.0;
+  double cost_seconds = 0.0;  // what the run is priced by: `seconds`, or its CPU time with --cpu-time
 };
+
+// The process's CPU time so far, user and system, over all its threads.
+double process_cpu_seconds() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
 
 Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                 const SweepOptions& o, const Reference& reference, const std::string& label,
                 bool show_progress, std::vector<float>* image = nullptr, std::uint32_t first_sample = 0) {
+  const double cpu_start = process_cpu_seconds();
   const MeasuredRun run =
       render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads, first_sample}, label, show_progress);
   Run r;
   r.spp = run.stats.spp;
   r.seconds = run.stats.seconds;
+  r.cost_seconds = o.cpu_time ? process_cpu_seconds() - cpu_start : r.seconds;
   // Corrected for the reference's own noise when it has a variance (as bench does).
   const std::vector<float> mean = run.film.mean_rgb();
   r.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
   if (image) *image = mean;
-  r.efficiency = efficiency(r.relmse, r.seconds);
+  r.efficiency = efficiency(r.relmse, r.cost_seconds);
   r.samples_per_second = run.stats.samples_per_second;
   return r;
 }
@@ -175,6 +188,7 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
   std::vector<double> sum(values, 0.0);
   AutoRun out;
   double seconds = 0.0, share = 0.0;
+  const double cpu_start = process_cpu_seconds();
   std::uint32_t spp = 0;
   for (int pass = 0; pass < AutoWeight::kPasses; ++pass) {
     const double w = chooser.weight();
@@ -219,7 +233,8 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
     po.relative_epsilon = kRelMseEpsilon;
     const WeightPredictor predictor = record_weight_paths(*scene, mixtures, family.at(w), w, chooser.grid(), po);
     // The pass's own time per sample and its paths' rays feed the cost model.
-    chooser.add_pass(predict_image_wide(predictor, so_far, r.seconds / r.spp, kRelMseEpsilon), r.seconds / r.spp);
+    chooser.add_pass(predict_image_wide(predictor, so_far, r.cost_seconds / r.spp, kRelMseEpsilon),
+                     r.cost_seconds / r.spp);
     const std::vector<float> traced_mean = traced.mean_rgb();
     for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(traced_mean[i]) * po.samples;
     spp += po.samples;
@@ -232,8 +247,9 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
   out.cost = chooser.cost_model();
   out.run.spp = spp;
   out.run.seconds = seconds;
+  out.run.cost_seconds = o.cpu_time ? process_cpu_seconds() - cpu_start : seconds;
   out.run.relmse = measure_relmse(mean, reference.rgb, reference.variance).corrected;
-  out.run.efficiency = efficiency(out.run.relmse, seconds);
+  out.run.efficiency = efficiency(out.run.relmse, out.run.cost_seconds);
   return out;
 }
 
@@ -443,18 +459,18 @@ int run_sweep(const SweepOptions& o) {
         const WeightPredictor predictor = record_weight_paths(*scene, mixture_family, r.strategy, r.weight, grid, po);
         if (!o.map.empty() && map_png.empty())
           map_png = best_weight_png(predictor, reference.rgb, scene->camera.width, scene->camera.height);
-        predictions.push_back(predictor.predict(reference.rgb, run.seconds / run.spp, kRelMseEpsilon));
+        predictions.push_back(predictor.predict(reference.rgb, run.cost_seconds / run.spp, kRelMseEpsilon));
       }
       seconds[i].push_back(run.seconds);
       rel[i].push_back(run.relmse);
       sps[i].push_back(run.samples_per_second);
       if (run.spp > 0) {
         relspp[i].push_back(run.relmse * run.spp);
-        per_sample[i].push_back(run.seconds / run.spp);
+        per_sample[i].push_back(run.cost_seconds / run.spp);
       }
       if (!o.quiet && !tty)
-        std::fprintf(stderr, "%s: %u spp, %.2f s, relMSE %.4g, efficiency %.4g, load %.2f\n", label, run.spp,
-                     run.seconds, run.relmse, run.efficiency, load_average());
+        std::fprintf(stderr, "%s: %u spp, %.2f s (priced %.2f s), relMSE %.4g, efficiency %.4g, load %.2f\n", label,
+                     run.spp, run.seconds, run.cost_seconds, run.relmse, run.efficiency, load_average());
     }
     if (!o.auto_weight) continue;
     char label[64];
@@ -463,15 +479,16 @@ int run_sweep(const SweepOptions& o) {
                                   label, show_progress);
     if (a.run.spp > 0) {
       auto_relspp.push_back(a.run.relmse * a.run.spp);
-      auto_per_sample.push_back(a.run.seconds / a.run.spp);
+      auto_per_sample.push_back(a.run.cost_seconds / a.run.spp);
     }
     auto_rel.push_back(a.run.relmse);
     auto_sec.push_back(a.run.seconds);
     auto_weights.push_back(a.weights);
     auto_offset.push_back(a.cost.offset());
     if (!o.quiet && !tty)
-      std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting), relMSE %.4g, efficiency %.4g, load %.2f\n", label,
-                   a.run.spp, a.run.seconds, a.replay_seconds, a.run.relmse, a.run.efficiency, load_average());
+      std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting; priced %.2f s), relMSE %.4g, efficiency %.4g, load %.2f\n",
+                   label, a.run.spp, a.run.seconds, a.replay_seconds, a.run.cost_seconds, a.run.relmse, a.run.efficiency,
+                   load_average());
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     rows[i].seconds = interval(seconds[i]);
@@ -738,7 +755,8 @@ int run_sweep(const SweepOptions& o) {
   else
     std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
                 1.0 - kDefensiveFloor);
-  std::printf("load average (1 min): %.2f at the start, %.2f at the end\n", load_at_start, load_average());
+  std::printf("load average (1 min): %.2f at the start, %.2f at the end; runs priced by %s\n", load_at_start,
+              load_average(), o.cpu_time ? "their CPU time (--cpu-time)" : "the wall clock");
   return 0;
 }
 

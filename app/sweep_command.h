@@ -23,6 +23,10 @@ struct SweepOptions {
   int threads = 0;
   bool quiet = false;
   bool auto_weight = false;  // also render with the weight chosen between passes
+  // Price the runs by the CPU time of the process (the render threads, and
+  // auto weight's prediction) instead of the wall clock: on a machine shared
+  // with other work the wall clock's time per sample follows the others' load.
+  bool cpu_time = false;
 
 };
 

@@ -1000,6 +1000,7 @@ void Viewer::Impl::service_weights() {
   in.a = mixture ? pair[0] : -1;
   in.b = mixture ? pair[1] : -1;
   in.image = &measure.published;
+  in.pricing = auto_run.on ? &auto_run.chooser : nullptr;
   if (weight_lab->update(in)) {
     measure.set_weight_maps(weight_lab->maps());
     settle_frames = std::max(settle_frames, 1);
@@ -1036,7 +1037,7 @@ void Viewer::Impl::service_auto_weight() {
     return;
   // At the stop (or past it) there is no next pass to choose a weight for.
   if (settings.stop_spp != 0 && image_info.spp >= settings.stop_spp) return;
-  auto_run.chooser.add_pass(*p);
+  auto_run.chooser.add_pass(*p, weight_lab->seconds_per_sample());
   while (auto_run.next_spp <= image_info.spp) auto_run.next_spp *= 2;
   const double w = auto_run.chooser.weight();
   auto_run.history.push_back(static_cast<float>(w));

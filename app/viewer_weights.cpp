@@ -71,6 +71,7 @@ WeightLab::Result WeightLab::run_round(Round& r) {
     }
   out.predictor = std::move(r.predictor);
   out.share = std::move(r.share);
+  out.seconds_per_sample = r.seconds_per_pass;
   out.width = width;
   out.height = height;
   out.block = block;
@@ -89,16 +90,17 @@ void WeightLab::reset(std::uint64_t generation) {
   predictor_.reset();
   share_.clear();
   prediction_.reset();
+  seconds_per_sample_ = 0.0;
   curve_ = {};
   curve_.why = "waiting for the first samples";
   maps_ = {};
   maps_.why = "waiting for the prediction";
 }
 
-void WeightLab::take(Result r) {
+void WeightLab::take(Result r, const AutoWeight& pricing) {
   predictor_ = std::move(r.predictor);
   share_ = std::move(r.share);
-  const WeightPrediction& p = r.prediction;
+  const WeightPrediction p = pricing.priced(r.prediction, r.seconds_per_sample);
   curve_.active = p.best >= 0;
   curve_.why = curve_.active ? "" : "no path has found light yet";
   curve_.weight.assign(p.weight.begin(), p.weight.end());
@@ -121,7 +123,8 @@ void WeightLab::take(Result r) {
   maps_.share_a = std::move(r.share_a);
   maps_.paths = p.paths;
   maps_.why.clear();
-  prediction_ = r.prediction;
+  prediction_ = std::move(r.prediction);
+  seconds_per_sample_ = r.seconds_per_sample;
 }
 
 bool WeightLab::update(const Input& in) {
@@ -129,7 +132,8 @@ bool WeightLab::update(const Input& in) {
   if (job_.valid() && job_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     Result r = job_.get();
     if (job_generation_ == generation_) {
-      take(std::move(r));
+      const AutoWeight prior;
+      take(std::move(r), in.pricing ? *in.pricing : prior);
       changed = true;
     }
   }
@@ -178,7 +182,10 @@ bool WeightLab::update(const Input& in) {
   const int width = in.scene->camera.width, height = in.scene->camera.height;
   int block = 1;
   while (block_cells(width, height, block) > kMaxCells) ++block;
-  round->options.seed = in.seed;
+  // Paths of their own (forecast_seed), at the indices this generation's
+  // samples have under the render's seed: a later generation (auto weight's
+  // next pass) starts past them and traces other paths again.
+  round->options.seed = forecast_seed(in.seed);
   round->options.first_sample = in.first_sample + replayed_;
   round->options.samples = kRoundSpp;
   round->options.threads = 1;  // beside the render's threads
@@ -187,7 +194,9 @@ bool WeightLab::update(const Input& in) {
   round->predictor = std::move(predictor_);
   round->share = std::move(share_);
   round->mean = in.image->rgb;
-  round->seconds_per_pass = info->seconds / info->spp;
+  // This generation's time over its own samples (auto weight's earlier
+  // passes are in the film's spp, not in the generation's seconds).
+  round->seconds_per_pass = info->seconds / drawn;
   replayed_ += kRoundSpp;
   job_generation_ = generation_;
   job_ = std::async(std::launch::async, [round] { return run_round(*round); });

@@ -1,11 +1,13 @@
 #pragma once
 // The viewer's live answer to "where should the slider be?": while a mixture
-// of two techniques renders, a background job replays the samples already
-// drawn (the same seed and sample indices: the very paths of the render)
-// through the weight predictor, a little at a time, and turns them into the
-// predicted efficiency curve beside the w slider, the best-weight map and the
-// "which technique found the light" map. Auto weight steps the slider between
-// passes from the same prediction.
+// of two techniques renders, a background job traces paths at the render's
+// weight under forecast_seed (weight_paths.h: independent of the render's own
+// samples, so of the published mean they are predicted against), a little at
+// a time, as many per pixel as the render has drawn, and turns them into the
+// predicted efficiency curve beside the w slider, priced by auto weight's cost
+// model (AutoWeight::priced), the best-weight map and the "which technique
+// found the light" map. Auto weight steps the slider between passes from the
+// same prediction and the pass's measured time, as sweep --auto does.
 #include "renderer/metrics/weight_paths.h"
 #include "renderer/metrics/weight_prediction.h"
 #include "renderer/scene/scene.h"
@@ -42,6 +44,9 @@ class WeightLab {
     std::uint64_t generation = 0;
     int a = -1, b = -1;  // the w slider's techniques (indices); -1: no pair
     const PublishedImage* image = nullptr;  // the latest published pass
+    // Prices the curve: auto weight's chooser while it runs (its cost model
+    // fitted to its passes); null: a fresh one (the prior fixed cost).
+    const AutoWeight* pricing = nullptr;
   };
   // Once a frame. Starts a round when one is due, takes a finished one.
   // Returns true when the curve or the maps changed.
@@ -50,7 +55,10 @@ class WeightLab {
   const ui::WeightCurveStatus& curve() const { return curve_; }
   const ui::WeightMaps& maps() const { return maps_; }
   // The latest prediction, of `generation`, on AutoWeight's grid; none before the first round.
+  // Unpriced (AutoWeight::add_pass prices it), with the render's measured
+  // seconds per sample at this weight.
   const std::optional<WeightPrediction>& prediction() const { return prediction_; }
+  double seconds_per_sample() const { return seconds_per_sample_; }
   std::uint64_t generation() const { return generation_; }
 
   // One round of replay, run off the UI thread, and what it gives back.
@@ -72,12 +80,13 @@ class WeightLab {
     WeightPrediction prediction;
     std::vector<float> best_weight, share_a;
     int width = 0, height = 0, block = 1;
+    double seconds_per_sample = 0.0;
   };
   static Result run_round(Round& round);
 
  private:
   void reset(std::uint64_t generation);
-  void take(Result r);
+  void take(Result r, const AutoWeight& pricing);
 
   std::uint64_t generation_ = ~std::uint64_t{0};
   double w_ = -1.0;
@@ -87,6 +96,7 @@ class WeightLab {
   std::future<Result> job_;
   std::uint64_t job_generation_ = 0;
   std::optional<WeightPrediction> prediction_;
+  double seconds_per_sample_ = 0.0;
   ui::WeightCurveStatus curve_;
   ui::WeightMaps maps_;
 };

@@ -6,6 +6,7 @@
 #include "renderer/metrics/weight_paths.h"
 
 #include "renderer/error.h"
+#include "renderer/integrator/integrator.h"
 
 #include <gtest/gtest.h>
 
@@ -345,6 +346,38 @@ TEST(CostFit, AutoWeightLearnsTheCostFromItsPasses) {
   EXPECT_TRUE(chooser.cost_model().fitted);
   EXPECT_NEAR(chooser.cost_model().offset(), truth.offset(), 0.05 * truth.offset());
   EXPECT_NEAR(chooser.weight(), with_fixed, 0.03);
+}
+
+// The viewer's curve is priced by AutoWeight::priced: before any fit, the
+// prediction's own time split with the prior fixed cost, which is the model
+// add_pass makes of a first pass, so the curve's best is auto weight's next
+// weight; after a fit, the fitted model.
+TEST(CostFit, PricedCurveIsWhatAutoWeightChoosesFrom) {
+  const Mixture m;
+  const auto cost = [](double x) { return x < 0.2 ? 101.0 : 1.0; };
+  const double mu = integrate(f);
+  const pdflab::CostModel truth{60.0e-6, 1.0e-6, true};
+  const std::vector<float> mean = {static_cast<float>(mu), static_cast<float>(mu), static_cast<float>(mu)};
+  pdflab::AutoWeight chooser(0.5, 101, truth.offset());  // the prior is the truth here
+  const pdflab::WeightPrediction pred = draw(m, 0.5, 100000, 40, chooser.grid(), cost).predict(mean, 0.0, 0.0);
+  const double seconds = truth.seconds(pred.sampling_cost);
+  const pdflab::WeightPrediction curve = chooser.priced(pred, seconds);
+  pdflab::WeightPrediction exact = pred;
+  pdflab::apply_cost_model(exact, truth);
+  for (std::size_t g = 0; g < curve.efficiency.size(); ++g)
+    EXPECT_NEAR(curve.efficiency[g], exact.efficiency[g], 1e-9 * exact.efficiency[g]) << g;
+  chooser.add_pass(pred, seconds);
+  EXPECT_NEAR(chooser.weight(), pdflab::defended_weight(curve.best_weight()), 1e-12);
+  // With no prior fixed cost the same prediction prices by rays alone, and its best moves.
+  const pdflab::WeightPrediction rays_only = pdflab::AutoWeight(0.5, 101, 0.0).priced(pred, seconds);
+  EXPECT_GT(std::fabs(rays_only.best_weight() - curve.best_weight()), 0.03);
+}
+
+TEST(WeightPrediction, ForecastSeedIsAnotherSeed) {
+  for (std::uint64_t seed : {0ull, 1ull, 2ull, 0x9e3779b97f4a7c15ull, ~0ull}) {
+    EXPECT_NE(pdflab::forecast_seed(seed), seed);
+    EXPECT_NE(pdflab::SampleSeed(pdflab::forecast_seed(seed)).rng_key, pdflab::SampleSeed(seed).rng_key);
+  }
 }
 
 TEST(WeightPrediction, DefensiveFloor) {

@@ -210,6 +210,23 @@ WeightPrediction predict_image_wide(const WeightPredictor& predictor, const std:
   return predictor.predict(unit, seconds_per_sample, 0.0, 0.0, &square);
 }
 
+std::uint64_t forecast_seed(std::uint64_t render_seed) {
+  // SampleSeed hashes the seed into its keys: any other seed gives other
+  // random streams and other per-pixel scrambles.
+  return render_seed ^ 0x9e3779b97f4a7c15ULL;
+}
+
+WeightPrediction AutoWeight::priced(WeightPrediction p, double seconds_per_sample) const {
+  CostModel model = model_;
+  if (!(model.per_ray > 0.0) && seconds_per_sample > 0.0) {
+    CostFit one;
+    one.add(p.sampling_cost, seconds_per_sample);
+    model = one.fit(prior_offset_, kFitSpread);
+  }
+  if (model.per_ray > 0.0) apply_cost_model(p, model);
+  return p;
+}
+
 double AutoWeight::pass_share(int pass) {
   static constexpr double kShare[kPasses] = {1.0 / 32, 3.0 / 32, 1.0 / 8, 1.0 / 4, 1.0 / 2};
   return pass >= 0 && pass < kPasses ? kShare[pass] : 0.0;

@@ -95,6 +95,15 @@ enum TechniqueShare : int { kShareA = 0, kShareB = 1, kShareRest = 2, kShareDire
 WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& family, const Strategy& mixture,
                                     double w, const std::vector<double>& grid, const WeightPathOptions& options);
 
+// The seed of the paths a prediction traces beside a render whose film it
+// cannot add them to (the viewer, whose session owns the film). A prediction
+// must not use the very samples of the mean it is compared with (a bright path
+// would raise its own pixel's mean and hold its own share of the second moment
+// down, leaning the prediction towards the weight it was drawn at), nor random
+// numbers a later pass will reuse: under this seed its paths share neither
+// random streams nor pixel positions with the render of `render_seed`.
+std::uint64_t forecast_seed(std::uint64_t render_seed);
+
 // Auto weight: each pass renders with one fixed weight chosen from the
 // predictions of the passes before it, never from its own samples. Every
 // pass is then an unbiased estimate of the image whatever its weight, and so
@@ -136,6 +145,11 @@ class AutoWeight {
   // predicted efficiency so far under the cost model fitted so far, kept
   // inside the defensive floor.
   void add_pass(const WeightPrediction& prediction, double seconds_per_sample = 0.0);
+  // `prediction` priced as add_pass prices the passes: by the cost model
+  // fitted to the passes so far or, before a fit, by its own seconds per
+  // sample split with the prior fixed cost (the same model add_pass makes of
+  // a first pass). What the viewer's curve shows.
+  WeightPrediction priced(WeightPrediction prediction, double seconds_per_sample) const;
   const std::vector<double>& grid() const { return grid_; }
   const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next
   const CostModel& cost_model() const { return model_; }           // the latest fit (zero before a timed pass)
