@@ -69,6 +69,14 @@ void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int
       s.weights[a] = static_cast<float>(c.best);
       s.weights[b] = 1.0f - static_cast<float>(c.best);
     }
+    if (c.fixed_cost_rays >= 0.0) {
+      ImGui::TextColored(kDim, "a sample costs its rays + %.1f rays (%s)", c.fixed_cost_rays,
+                         c.cost_fitted ? "fitted to the passes' times" : "prior");
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Time per sample = fixed cost + cost per ray x rays. The fixed cost (the camera ray's set-up,\n"
+                          "the film, the pass's bookkeeping) is fitted to auto weight's passes once their rays differ\n"
+                          "enough; until then it is a prior.");
+    }
   }
   ImGui::Checkbox("Auto weight", &settings.auto_weight);
   if (ImGui::IsItemHovered())

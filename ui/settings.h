@@ -115,6 +115,8 @@ struct WeightCurveStatus {
   double best = -1.0;      // the predicted best weight (A's share)
   double sampling = -1.0;  // the weight the paths were drawn at
   std::uint64_t paths = 0;
+  double fixed_cost_rays = -1.0;  // the cost model's fixed cost per sample, in rays (-1: not priced)
+  bool cost_fitted = false;       // fitted to auto weight's passes (else the prior)
   std::vector<float> history;  // auto weight: each pass's weight, oldest first
 };
 

@@ -216,13 +216,15 @@ std::uint64_t forecast_seed(std::uint64_t render_seed) {
   return render_seed ^ 0x9e3779b97f4a7c15ULL;
 }
 
+CostModel AutoWeight::pricing_model(const WeightPrediction& p, double seconds_per_sample) const {
+  if (model_.per_ray > 0.0 || !(seconds_per_sample > 0.0)) return model_;
+  CostFit one;
+  one.add(p.sampling_cost, seconds_per_sample);
+  return one.fit(prior_offset_, kFitSpread);
+}
+
 WeightPrediction AutoWeight::priced(WeightPrediction p, double seconds_per_sample) const {
-  CostModel model = model_;
-  if (!(model.per_ray > 0.0) && seconds_per_sample > 0.0) {
-    CostFit one;
-    one.add(p.sampling_cost, seconds_per_sample);
-    model = one.fit(prior_offset_, kFitSpread);
-  }
+  const CostModel model = pricing_model(p, seconds_per_sample);
   if (model.per_ray > 0.0) apply_cost_model(p, model);
   return p;
 }

@@ -150,6 +150,8 @@ class AutoWeight {
   // sample split with the prior fixed cost (the same model add_pass makes of
   // a first pass). What the viewer's curve shows.
   WeightPrediction priced(WeightPrediction prediction, double seconds_per_sample) const;
+  // The model priced() uses for a prediction with this time per sample.
+  CostModel pricing_model(const WeightPrediction& prediction, double seconds_per_sample) const;
   const std::vector<double>& grid() const { return grid_; }
   const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next
   const CostModel& cost_model() const { return model_; }           // the latest fit (zero before a timed pass)
