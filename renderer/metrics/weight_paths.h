@@ -117,8 +117,9 @@ std::uint64_t forecast_seed(std::uint64_t render_seed);
 // aluminium box, whose 0.5 has half the best weight's efficiency); after each
 // pass but the last a few more samples per pixel are traced for the
 // prediction (replay_samples: about 1/32 of the pass, 1 to 8: predicting
-// costs several per cent of a short run, less of a long one), and the next weight is the best of the passes' predicted curves
-// so far, each counted by its number of paths.
+// costs several per cent of a short run, less of a long one), and the next
+// weight is the best of the passes' predictions so far, pooled (each counted
+// by its number of paths) and taken cautiously (see add_pass).
 //
 // The time a weight costs comes from a CostModel (weight_prediction.h) fitted
 // to the passes' own timing: each pass gives its seconds per sample and its
@@ -140,10 +141,11 @@ class AutoWeight {
   explicit AutoWeight(double first = 0.5, int grid_points = 21, double prior_offset = kPriorOffset);
   double weight() const { return history_.back(); }  // for the next pass
   // A finished pass's prediction (on grid()) and its measured seconds per
-  // sample (one sample in every cell; 0: unknown, the prediction's own
-  // efficiency is used): the next weight is the best of the path-weighted mean
-  // predicted efficiency so far under the cost model fitted so far, kept
-  // inside the defensive floor.
+  // sample (one sample in every cell; 0: unknown, rays alone price it): the
+  // next weight is the best of the passes' pooled prediction (relative
+  // variance and rays, each pass counted by its paths) under the cost model
+  // fitted so far, with the variance taken one standard error high (where the
+  // prediction has one: predict_image_wide), kept inside the defensive floor.
   void add_pass(const WeightPrediction& prediction, double seconds_per_sample = 0.0);
   // `prediction` priced as add_pass prices the passes: by the cost model
   // fitted to the passes so far or, before a fit, by its own seconds per
