@@ -86,7 +86,7 @@ WeightLab::~WeightLab() {
 
 void WeightLab::reset(std::uint64_t generation) {
   generation_ = generation;
-  replayed_ = 0;
+  traced_ = 0;
   predictor_.reset();
   share_.clear();
   prediction_.reset();
@@ -176,7 +176,7 @@ bool WeightLab::update(const Input& in) {
   if (job_.valid() || !info || info->preview || info->generation != in.generation || info->spp == 0) return changed;
   const std::uint32_t drawn = info->spp > in.spp_before ? info->spp - in.spp_before : 0;
   const std::uint32_t wanted = std::min(drawn, kMaxSpp);
-  if (replayed_ + kRoundSpp > wanted) return changed;
+  if (traced_ + kRoundSpp > wanted) return changed;
 
   auto round = std::make_shared<Round>();
   round->scene = in.scene;
@@ -190,7 +190,7 @@ bool WeightLab::update(const Input& in) {
   // samples have under the render's seed: a later generation (auto weight's
   // next pass) starts past them and traces other paths again.
   round->options.seed = forecast_seed(in.seed);
-  round->options.first_sample = in.first_sample + replayed_;
+  round->options.first_sample = in.first_sample + traced_;
   round->options.samples = kRoundSpp;
   round->options.threads = 1;  // beside the render's threads
   round->options.block = block;
@@ -201,7 +201,7 @@ bool WeightLab::update(const Input& in) {
   // This generation's time over its own samples (auto weight's earlier
   // passes are in the film's spp, not in the generation's seconds).
   round->seconds_per_pass = info->seconds / drawn;
-  replayed_ += kRoundSpp;
+  traced_ += kRoundSpp;
   job_generation_ = generation_;
   job_ = std::async(std::launch::async, [round] { return run_round(*round); });
   return changed;

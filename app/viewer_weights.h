@@ -25,7 +25,7 @@ namespace pdflab {
 
 class WeightLab {
  public:
-  // Samples per pixel replayed per round, and in all for one generation.
+  // Samples per pixel traced per round, and in all for one generation.
   static constexpr std::uint32_t kRoundSpp = 1, kMaxSpp = 64;
   // At most this many predictor cells: larger images are predicted per block.
   static constexpr int kMaxCells = 16384;
@@ -61,7 +61,7 @@ class WeightLab {
   double seconds_per_sample() const { return seconds_per_sample_; }
   std::uint64_t generation() const { return generation_; }
 
-  // One round of replay, run off the UI thread, and what it gives back.
+  // One round of tracing, run off the UI thread, and what it gives back.
   struct Round {
     std::shared_ptr<const Scene> scene;
     MixtureFamily family;
@@ -69,7 +69,7 @@ class WeightLab {
     double w = 0.5;
     WeightPathOptions options;
     std::vector<double> grid;
-    std::unique_ptr<WeightPredictor> predictor;  // what earlier rounds replayed, or null
+    std::unique_ptr<WeightPredictor> predictor;  // what earlier rounds traced, or null
     std::vector<double> share;
     std::vector<float> mean;  // the published mean, width x height RGB
     double seconds_per_pass = 0.0;
@@ -90,8 +90,8 @@ class WeightLab {
 
   std::uint64_t generation_ = ~std::uint64_t{0};
   double w_ = -1.0;
-  std::uint32_t replayed_ = 0;
-  std::unique_ptr<WeightPredictor> predictor_;  // the replayed paths of this generation
+  std::uint32_t traced_ = 0;
+  std::unique_ptr<WeightPredictor> predictor_;  // the traced paths of this generation
   std::vector<double> share_;                   // per pixel, kShareKinds sums
   std::future<Result> job_;
   std::uint64_t job_generation_ = 0;

@@ -165,7 +165,7 @@ void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, c
       if (mode == ViewMode::BestWeight)
         ImGui::TextColored(kDim,
                            "Per %dx%d block, the weight of least predicted second moment (relative to the pixel, as "
-                           "relMSE weighs it), from %llu replayed paths. Red wants %s, blue %s; grey: w does not "
+                           "relMSE weighs it), from %llu paths traced for the prediction. Red wants %s, blue %s; grey: w does not "
                            "matter there.",
                            m.weight_maps.block, m.weight_maps.block,
                            static_cast<unsigned long long>(m.weight_maps.paths), m.weight_maps.a.c_str(),
