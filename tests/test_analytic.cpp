@@ -274,7 +274,9 @@ std::vector<Param> cases() {
                                                      "mix:cosine=0.5,light-sa=0.5", "nee-mis", "nee-mis:balance",
                                                      // continuations drawn by a mixture, Russian roulette
                                                      "nee-mis+mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light=0.5+rr:1",
-                                                     "nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr:1"};
+                                                     "nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr:1",
+                                                     // the +sobol sampler
+                                                     "mix:cosine=0.5,light=0.5+sobol", "nee-mis+sobol"};
   const std::vector<std::string> blind_strategies = {"cosine", "uniform-hemisphere",
                                                      "mix:uniform-sphere=0.5,light=0.5"};
   for (const double scale : {1e-3, 1.0, 1e3, 1e6}) {

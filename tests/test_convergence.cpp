@@ -71,6 +71,10 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"nee-mis+mix:cosine=0.5,light=0.5", 256},
       {"nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr", 256},
       {"fastest", 256},
+      // The +sobol sampler's stratified draws.
+      {"mix:cosine=0.5,light=0.5+sobol", 512},
+      {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256},
+      {"mix:cosine=0.5,light-sa=0.5+sobol+rr", 512},
   };
   return s;
 }
@@ -213,7 +217,9 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
                       {"nee-mis:balance", 128, false},
                       {"mix:cosine=0.5,light-sa=0.5+rr", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5", 128, false},
-                      {"fastest", 256, false}};  // today the book mixture: its spp
+                      {"fastest", 256, false},
+                      {"mix:cosine=0.5,light=0.5+sobol", 256, false},
+                      {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256, false}};  // today the book mixture: its spp
   constexpr int kSmall = 24;
   const int tests = static_cast<int>(std::size(scenes) * std::size(runs)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
   const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));

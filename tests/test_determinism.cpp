@@ -32,14 +32,14 @@ using testing::TempDir;
 // Renders the book scene at 24 x 20 (partial 16-pixel tiles on both axes) and
 // returns the PFM's bytes; stderr goes to a file in `dir` for diagnostics.
 std::string render_pfm(const TempDir& dir, const std::string& name, const std::string& threads,
-                       const std::string& seed) {
+                       const std::string& seed, const std::string& strategy = "mix:cosine=0.5,light=0.5") {
   const std::string out = dir.file(name);
   testing::ChildOptions o;
   o.cwd = dir.path();
   o.capture = dir.path();
   o.deadline_seconds = 120.0;
   const testing::ChildResult r =
-      testing::run_pdflab({"render", "--scene", kBookScene, "--strategy", "mix:cosine=0.5,light=0.5", "--spp", "8",
+      testing::run_pdflab({"render", "--scene", kBookScene, "--strategy", strategy, "--spp", "8",
                            "--width", "24", "--height", "20", "--seed", seed, "--threads", threads, "--out", out,
                            "--quiet"},
                           o);
@@ -58,6 +58,19 @@ TEST(Determinism, ThreadCountDoesNotChangeTheImage) {
   const std::string two = render_pfm(dir, "t2.pfm", "2", "11");
   ASSERT_FALSE(one.empty());
   EXPECT_TRUE(one == two) << "--threads 1 and --threads 2 gave different PFM bytes";
+}
+
+TEST(Determinism, ThreadCountDoesNotChangeTheSobolSamplersImage) {
+  TempDir dir;
+  for (const char* strategy : {"mix:cosine=0.5,light=0.5+sobol", "nee-mis+mix:cosine=0.5,light=0.5+sobol"}) {
+    const std::string one = render_pfm(dir, "s1.pfm", "1", "11", strategy);
+    const std::string two = render_pfm(dir, "s2.pfm", "2", "11", strategy);
+    const std::string without = std::string(strategy).substr(0, std::string(strategy).size() - 6);  // no +sobol
+    const std::string independent = render_pfm(dir, "s3.pfm", "2", "11", without);
+    ASSERT_FALSE(one.empty());
+    EXPECT_TRUE(one == two) << strategy << ": --threads 1 and --threads 2 gave different PFM bytes";
+    EXPECT_FALSE(one == independent) << strategy << ": the same image as without +sobol";
+  }
 }
 
 TEST(Determinism, SeedChangesTheImage) {

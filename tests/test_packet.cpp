@@ -33,7 +33,11 @@ const char* const kStrategies[] = {"cosine",
                                    "nee-mis+mix:cosine=0.5,light=0.5",
                                    "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2",
                                    "nee-mis+mix:uniform-sphere=0.5,light=0.5",
-                                   "fastest"};
+                                   "fastest",
+                                   "mix:cosine=0.5,light=0.5+sobol",
+                                   "nee-mis+sobol",
+                                   "nee-mis+mix:cosine=0.5,light=0.5+sobol+rr:1",
+                                   "light-sa+sobol"};
 
 Scene small_scene(const std::string& file, int width, int height) {
   Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);

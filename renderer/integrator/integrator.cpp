@@ -1,6 +1,7 @@
 #include "renderer/integrator/integrator.h"
 
 #include "renderer/sampling/mixture.h"
+#include "renderer/sampling/sobol.h"
 
 namespace pdflab {
 
@@ -23,22 +24,40 @@ Vec3 checked_radiance(const Vec3& radiance, DropCounts& drops) {
   return Vec3(0.0f);
 }
 
+// The `+sobol` sampler's point of a draw group at the vertex reached by
+// segment `depth`, for this sample (where SamplingPlan::stratifies(depth); the
+// pcg stream is stepped as without, its numbers replaced).
+qmc::Point<std::uint32_t> stratified_point(const Rng& rng, int depth, qmc::Group group, int dims) {
+  return qmc::group_point(rng.qmc_index, rng.qmc_seed, static_cast<std::uint32_t>(depth), group, dims);
+}
+
 // Follows a metal or dielectric bounce from `hit` (`normal` faces the incoming
 // ray); returns false when the path ends (absorbed). The scatter rules are
 // leaf math (metal_direction, dielectric_setup / dielectric_direction).
-bool scatter_specular(const Material& m, const Hit& hit, const Vec3& normal, bool front_face, Ray& ray,
-                      Vec3& throughput, Rng& rng) {
+bool scatter_specular(const SamplingPlan& plan, int depth, const Material& m, const Hit& hit, const Vec3& normal,
+                      bool front_face, Ray& ray, Vec3& throughput, Rng& rng) {
   Vec3 dir;
   if (m.type == MaterialType::Metal) {
     const bool fuzzy = m.fuzz > 0.0f;
     float u1 = 0.0f, u2 = 0.0f;
-    if (fuzzy) u1 = rng.uniform(), u2 = rng.uniform();
+    if (fuzzy) {
+      u1 = rng.uniform(), u2 = rng.uniform();
+      if (plan.stratifies(depth)) {
+        const qmc::Point<std::uint32_t> p = stratified_point(rng, depth, qmc::Group::Specular, 2);
+        u1 = Rng::to_unit(p.dim[0]), u2 = Rng::to_unit(p.dim[1]);
+      }
+    }
     dir = leaf::metal_direction(ray.direction, normal, m.fuzz, fuzzy, u1, u2);
     if (dot(dir, normal) <= 0.0f) return false;  // fuzz pushed it under the surface: absorbed
     throughput *= m.albedo;
   } else {
     const leaf::Refraction r = leaf::dielectric_setup(ray.direction, normal, front_face, m.ior);
-    const bool reflects = r.total_internal || r.reflectance > rng.uniform();
+    bool reflects = r.total_internal;
+    if (!reflects) {
+      float u = rng.uniform();
+      if (plan.stratifies(depth)) u = Rng::to_unit(stratified_point(rng, depth, qmc::Group::Specular, 1).dim[0]);
+      reflects = r.reflectance > u;
+    }
     dir = leaf::dielectric_direction(r, ray.direction, normal, reflects);
   }
   ray = spawn_ray(hit, dir);
@@ -91,7 +110,7 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
       break;
     }
     if (m.type != MaterialType::Lambertian) {
-      if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) break;
+      if (!scatter_specular(plan, depth, m, hit, normal, front_face, ray, throughput, rng)) break;
       unweighted_emission = true;
       continue;
     }
@@ -105,8 +124,12 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
     // vertex max_depth allows there is none (the path would have one too many).
     leaf::SolidAngleSetup setup{-1, {}};
     if (!plan.emitters.empty() && depth + 1 < scene.max_depth) {
-      const std::uint32_t uc = rng.next_u32();
-      const float u1 = rng.uniform(), u2 = rng.uniform();
+      std::uint32_t uc = rng.next_u32();
+      float u1 = rng.uniform(), u2 = rng.uniform();
+      if (plan.stratifies(depth)) {
+        const qmc::Point<std::uint32_t> p = stratified_point(rng, depth, qmc::Group::Light, 3);
+        u1 = Rng::to_unit(p.dim[0]), u2 = Rng::to_unit(p.dim[1]), uc = p.dim[2];
+      }
       const DirectionSample ls = to_direction_sample(
           leaf::sample_solid_angle_targets(plan.emitters, origin, static_cast<std::int32_t>(uc), u1, u2, true, setup));
       if (ls.none) {
@@ -135,7 +158,7 @@ Vec3 trace_path_nee(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& 
     if (!roulette_survives(plan, depth, throughput, m.albedo, rng)) break;
     // The continuation, drawn by the plan's mixture. Cosine alone: f cos / p
     // is exactly the albedo (the lobe's own z, not a rounded dot product).
-    const DirectionSample ds = plan.sample(origin, normal, rng);
+    const DirectionSample ds = plan.sample(origin, normal, rng, nullptr, depth);
     if (ds.none) break;  // a target seen edge-on: a valid zero estimate
     if (!(ds.pdf > 0.0f) || ds.pdf == kInf) {
       if (!plan.cosine_continuation) drops.add(ds.pdf == kInf || std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
@@ -193,7 +216,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       // Sampled, and its pdf evaluated, from the point the ray leaves from.
       const Vec3 origin = diffuse_origin(hit, normal);
       if (!roulette_survives(plan, depth, throughput, m.albedo, rng)) break;
-      const DirectionSample ds = plan.sample(origin, normal, rng);
+      const DirectionSample ds = plan.sample(origin, normal, rng, nullptr, depth);
       if (ds.none) break;  // a light seen edge-on: a valid zero estimate
       if (!(ds.pdf > 0.0f)) {
         drops.add(std::isnan(ds.pdf) ? DropReason::PdfNotFinite : DropReason::PdfZero);
@@ -212,31 +235,12 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       ray = Ray{origin, ds.direction};
       aimed_quad = ds.aimed_quad;
       aimed_distance = ds.aimed_distance;
-    } else if (!scatter_specular(m, hit, normal, front_face, ray, throughput, rng)) {
+    } else if (!scatter_specular(plan, depth, m, hit, normal, front_face, ray, throughput, rng)) {
       break;
     }
   }
   return checked_radiance(radiance, drops);
 }
-
-namespace {
-
-// Van der Corput (base 2) and the second Sobol dimension: together a (0,2)-sequence.
-inline std::uint32_t reverse_bits(std::uint32_t v) {
-  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
-  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
-  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
-  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
-  return (v >> 16) | (v << 16);
-}
-inline std::uint32_t sobol_dim2(std::uint32_t index) {
-  std::uint32_t result = 0;
-  for (std::uint32_t v = 1u << 31; index; index >>= 1, v ^= v >> 1)
-    result ^= v & (0u - (index & 1u));  // no branch on the bit
-  return result;
-}
-
-}  // namespace
 
 SampleSeed::SampleSeed(std::uint64_t seed_value)
     : rng_key(Rng::seed_key(seed_value)), scramble_key(mix64(seed_value ^ 0x5bd1e995u)) {}
@@ -248,12 +252,15 @@ PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, 
   // A random digital shift per pixel keeps the (0,2)-sequence's stratification
   // and decorrelates neighbouring pixels.
   const std::uint64_t scramble = mix64(seed.scramble_key + pixel);
-  const std::uint32_t sx = reverse_bits(sample_index) ^ static_cast<std::uint32_t>(scramble);
-  const std::uint32_t sy = sobol_dim2(sample_index) ^ static_cast<std::uint32_t>(scramble >> 32);
+  const std::uint32_t sx = qmc::sobol(sample_index, 0) ^ static_cast<std::uint32_t>(scramble);
+  const std::uint32_t sy = qmc::sobol(sample_index, 1) ^ static_cast<std::uint32_t>(scramble >> 32);
   const float jx = static_cast<float>(sx >> 8) * 0x1.0p-24f;
   const float jy = static_cast<float>(sy >> 8) * 0x1.0p-24f;
-  return {scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
-          Rng::for_sample_keyed(seed.rng_key, pixel, sample_index)};
+  PixelSampleStart start{scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
+                         Rng::for_sample_keyed(seed.rng_key, pixel, sample_index)};
+  start.rng.qmc_index = sample_index;
+  start.rng.qmc_seed = static_cast<std::uint32_t>(mix64(scramble));
+  return start;
 }
 
 Vec3 render_pixel_sample(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, int x, int y,

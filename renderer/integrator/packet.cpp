@@ -30,6 +30,8 @@
 // the note that their ABI differs without AVX does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
+#include "renderer/sampling/sobol.h"  // its templates run on the kernel's vectors too
+
 namespace pdflab {
 
 namespace packet_generic {

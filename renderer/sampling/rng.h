@@ -52,6 +52,11 @@ class Rng {
   }
   static float to_unit(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1.0p-24f; }
 
+  // The sample's key for the `+sobol` sampler's stratified draws
+  // (renderer/sampling/sobol.h): its index within the pixel and the pixel's
+  // scramble seed, both from (seed, pixel, sample index). Unused otherwise.
+  std::uint32_t qmc_index = 0, qmc_seed = 0;
+
  private:
   std::uint64_t increment_;  // odd; selects the stream
   std::uint64_t state_;

@@ -1,6 +1,7 @@
 #include "renderer/sampling/strategy.h"
 
 #include "renderer/sampling/mixture.h"
+#include "renderer/sampling/sobol.h"
 
 #include "renderer/error.h"
 
@@ -80,6 +81,7 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.nee_mis = strategy.nee_mis;
   plan.heuristic = strategy.heuristic;
   plan.roulette_depth = strategy.roulette_depth;
+  plan.sobol = strategy.sobol;
   // nee-mis's continuation is a mixture like any other.
   plan.cosine_continuation = strategy.nee_mis && strategy.cosine_continuation();
   plan.bind_targets();
@@ -95,11 +97,23 @@ float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& dire
   return leaf::mixture_pdf(*this, at, direction, true);
 }
 
-DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique) const {
+bool SamplingPlan::stratifies(int depth) const { return sobol && depth >= 0 && depth < qmc::kDepths; }
+
+DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique,
+                                     int depth) const {
   // nee-mis's continuation draws the technique's bits only when it mixes several.
-  const auto u0 = !nee_mis || continuation_mixes ? static_cast<std::int32_t>(rng.next_u32()) : 0;
-  const float u1 = rng.uniform();
-  const float u2 = rng.uniform();
+  const bool draws_technique = !nee_mis || continuation_mixes;
+  auto u0 = draws_technique ? static_cast<std::int32_t>(rng.next_u32()) : 0;
+  float u1 = rng.uniform();
+  float u2 = rng.uniform();
+  if (stratifies(depth)) {
+    // The stream stepped as above; the group's stratified point in its place.
+    const qmc::Point<std::uint32_t> p = qmc::group_point(rng.qmc_index, rng.qmc_seed, static_cast<std::uint32_t>(depth),
+                                                         qmc::Group::Continuation, 3);
+    u1 = Rng::to_unit(p.dim[0]);
+    u2 = Rng::to_unit(p.dim[1]);
+    if (draws_technique) u0 = static_cast<std::int32_t>(p.dim[2]);
+  }
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
   const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(rng.next_u32()) : 0;

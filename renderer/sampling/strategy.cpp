@@ -3,6 +3,7 @@
 #include "renderer/sampling/mixture.h"
 
 #include "renderer/error.h"
+#include "renderer/sampling/sobol.h"
 
 #include <charconv>
 #include <numbers>
@@ -31,7 +32,7 @@ std::string known_list() {
     out.append(t.name);
     if (!t.parameter.empty()) out.append("[:").append(t.parameter).append("]");
   }
-  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +rr or +rr:D)";
+  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +sobol, +rr or +rr:D)";
 }
 
 std::string format_number(float x) {
@@ -95,7 +96,7 @@ std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)
 
 std::string strategy_help() {
   std::string out =
-      "Strategies: BASE[+rr[:D]] | fastest\n"
+      "Strategies: BASE[+sobol][+rr[:D]] | fastest[+sobol][+rr[:D]]\n"
       "  BASE := MIXTURE | nee-mis[:balance][+MIXTURE]\n"
       "  MIXTURE := TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...]\n"
       "  nee-mis: a light sample and a continuation at each diffuse vertex, weighed by MIS (power heuristic,\n"
@@ -104,6 +105,10 @@ std::string strategy_help() {
       "  +rr[:D]: Russian roulette from D path segments on (default " + std::to_string(kDefaultRouletteDepth) +
       "): a path goes on with probability\n"
       "    min(1, largest throughput component), its throughput divided by it (unbiased; off by default)\n"
+      "  +sobol: the first " + std::to_string(qmc::kDepths) +
+      " vertices' draws (continuation, light sample, specular bounce) from Owen-scrambled Sobol points\n"
+      "    stratified across a pixel's samples, the rest from the sample's random stream (unbiased;\n"
+      "    off by default: every draw independent)\n"
       "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +
       "\nTechniques:\n";
   for (const TechniqueInfo& t : kTable) {
@@ -146,7 +151,7 @@ namespace {
 Strategy parse_mixture(std::string_view text, std::string_view whole) {
   if (text.empty()) throw InputError("strategy '" + std::string(whole) + "': the mixture is empty");
   if (text.find('+') != std::string_view::npos)
-    throw InputError("strategy '" + std::string(whole) + "': '+' joins only nee-mis, its continuation and rr");
+    throw InputError("strategy '" + std::string(whole) + "': '+' joins only nee-mis, its continuation, sobol and rr");
   constexpr std::string_view kMix = "mix:";
   if (text.substr(0, kMix.size()) != kMix) {
     const ParsedTechnique p = parse_technique(text, whole);
@@ -205,11 +210,21 @@ Strategy Strategy::parse(std::string_view text) {
   const std::string_view whole = trim(text);
   if (whole.empty()) throw InputError("empty strategy; expected one of: " + known_list());
   std::string_view body = whole;
-  // A last term `rr[:D]` turns on Russian roulette.
+  // Last terms `sobol` and `rr[:D]`, in either order, choose the sampler and
+  // turn on Russian roulette.
   int roulette = 0;
-  const std::size_t last_plus = body.rfind('+');
-  if (last_plus != std::string_view::npos && trim(body.substr(last_plus + 1)).substr(0, 2) == "rr") {
-    roulette = parse_roulette(trim(body.substr(last_plus + 1)), whole);
+  bool sobol = false;
+  for (;;) {
+    const std::size_t last_plus = body.rfind('+');
+    if (last_plus == std::string_view::npos) break;
+    const std::string_view term = trim(body.substr(last_plus + 1));
+    if (term.substr(0, 2) == "rr" && !roulette) {
+      roulette = parse_roulette(term, whole);
+    } else if (term == "sobol" && !sobol) {
+      sobol = true;
+    } else {
+      break;
+    }
     body = trim(body.substr(0, last_plus));
   }
   Strategy s;
@@ -217,6 +232,7 @@ Strategy Strategy::parse(std::string_view text) {
     s = parse(kFastestStrategy);
     s.fastest = true;
     if (roulette) s.roulette_depth = roulette;
+    if (sobol) s.sobol = true;
     return s;
   }
   if (body.substr(0, 7) == "nee-mis") {
@@ -239,6 +255,7 @@ Strategy Strategy::parse(std::string_view text) {
     s = parse_mixture(body, whole);
   }
   s.roulette_depth = roulette;
+  s.sobol = sobol;
   return s;
 }
 
@@ -256,6 +273,7 @@ std::string Strategy::to_string() const {
   } else {
     out = mixture_string();
   }
+  if (sobol) out.append("+sobol");
   if (roulette_depth > 0) {
     out.append("+rr");
     if (roulette_depth != kDefaultRouletteDepth) out.append(":").append(std::to_string(roulette_depth));

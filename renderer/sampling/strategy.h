@@ -38,7 +38,7 @@ inline constexpr int kMaxRouletteDepth = 10000;
 
 // As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,
 // `nee-mis:balance`, `nee-mis+mix:cosine=0.5,light=0.5`, any of them with
-// `+rr` or `+rr:D`, or `fastest`... Mixture weights are kept as given
+// `+sobol` and `+rr` or `+rr:D`, or `fastest`... Mixture weights are kept as given
 // (normalised by SamplingPlan). Parsing validates; see README.md.
 struct Strategy {
   // The techniques that draw the direction at a diffuse bounce; for nee-mis,
@@ -59,6 +59,13 @@ struct Strategy {
   // path goes on with probability min(1, largest component of throughput *
   // albedo), its throughput divided by that (leaf::russian_roulette).
   int roulette_depth = 0;
+  // `+sobol`: the first diffuse and specular vertices' draws (the continuation's
+  // technique and direction, the light sample's emitter and point, a specular
+  // bounce's numbers) at path depths below qmc::kDepths come from Owen-scrambled
+  // Sobol points across a pixel's samples (renderer/sampling/sobol.h), every
+  // other draw from the sample's pcg stream as before (off: the independent
+  // sampler, every draw from the stream). Unbiased either way.
+  bool sobol = false;
   // Parsed from `fastest`: the fields above are what it expanded to
   // (kFastestStrategy), which to_string gives; sidecars record both.
   bool fastest = false;
@@ -110,6 +117,10 @@ struct SamplingPlan {
   bool cosine_continuation = false;
   bool continuation_mixes = false;
   int roulette_depth = 0;  // Strategy::roulette_depth
+  bool sobol = false;      // Strategy::sobol
+  // Whether the vertex reached by segment `depth` takes its draws from the
+  // `+sobol` sampler's stratified points (depth -1: never).
+  bool stratifies(int depth) const;
 
   TargetSet book_targets;   // `light`: the importance targets, chosen uniformly
   TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
@@ -124,7 +135,10 @@ struct SamplingPlan {
   // Draws a direction from the mixture and returns it with the mixture's pdf
   // sum_i w_i p_i(direction). `normal` faces the incoming ray's side.
   // `technique`, when given, receives which technique drew the direction.
-  DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr) const;
+  // `depth`: the path depth of the vertex (the camera ray is segment 0), for
+  // the `+sobol` sampler's stratified draws; -1: every draw from `rng`.
+  DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr,
+                         int depth = -1) const;
   // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
             float aimed_t = 0.0f) const;

@@ -1,0 +1,188 @@
+#pragma once
+// Randomized quasi-Monte Carlo: Owen-scrambled Sobol points, for the `+sobol`
+// sampler (Strategy::sobol).
+//
+// The first three Sobol dimensions (van der Corput, and the primitive
+// polynomials x + 1 and x^2 + x + 1) are scrambled by a hash-based nested
+// uniform scramble in the manner of Laine and Karras (2011) and Burley
+// (2020, "Practical Hash-based Owen Scrambling"): a bit of the point is
+// flipped by a hash of the bits above it only, so every elementary interval
+// of the unscrambled net maps onto one of the same shape and the net's
+// stratification is kept, while each point is uniform in [0,1)^3. Each draw
+// group of a sample (one vertex's continuation, its light sample, a specular
+// bounce) takes the point of its own shuffled sample index, the index itself
+// Owen-scrambled with the group's seed (Burley's padding), so groups are
+// mutually independent while each is stratified across a pixel's samples.
+//
+// Every function is a template over the integer type: std::uint32_t for the
+// one-path tracer, a vector of uint32 lanes (GCC vector extensions) for the
+// packet tracer, so both compute the same bits with the same code.
+#include <cstdint>
+#include <type_traits>
+
+// Always inlined, so that in the packet tracer they compile inside its
+// instruction set's target region, on its vectors whole.
+#if defined(__GNUC__)
+#define PDFLAB_QMC inline __attribute__((always_inline))
+#else
+#define PDFLAB_QMC inline
+#endif
+
+namespace pdflab::qmc {
+
+// How many bits a dimension of the point has, and the largest power of two of
+// samples whose stratification it carries in full.
+inline constexpr int kBits = 32;
+
+template <class U>
+PDFLAB_QMC U reverse_bits(U v) {
+  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
+  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+  return (v >> 16) | (v << 16);
+}
+
+// The generator matrices' columns of Sobol's dimensions 1 and 2 (dimension 0,
+// van der Corput, is the bit reversal): column k is the point of index 2^k.
+// Bratley and Fox's recurrence with the direction numbers m = (1) for x + 1
+// and m = (1, 3) for x^2 + x + 1.
+struct Directions {
+  std::uint32_t column[2][kBits]{};
+};
+constexpr Directions make_directions() {
+  Directions d;
+  // x + 1 (degree 1): v_k = v_{k-1} ^ (v_{k-1} >> 1).
+  d.column[0][0] = 1u << 31;
+  for (int k = 1; k < kBits; ++k) d.column[0][k] = d.column[0][k - 1] ^ (d.column[0][k - 1] >> 1);
+  // x^2 + x + 1 (degree 2, a_1 = 1): v_k = v_{k-1} ^ v_{k-2} ^ (v_{k-2} >> 2).
+  d.column[1][0] = 1u << 31;  // m_1 = 1
+  d.column[1][1] = 3u << 30;  // m_2 = 3
+  for (int k = 2; k < kBits; ++k)
+    d.column[1][k] = d.column[1][k - 1] ^ d.column[1][k - 2] ^ (d.column[1][k - 2] >> 2);
+  return d;
+}
+inline constexpr Directions kDirections = make_directions();
+
+// Sobol dimension `dim` (0, 1 or 2) of point `index`, unscrambled, as 32 bits.
+template <class U>
+PDFLAB_QMC U sobol(U index, int dim) {
+  if (dim == 0) return reverse_bits(index);
+  const std::uint32_t* column = kDirections.column[dim - 1];
+  U result = index ^ index;  // zero, of U's type
+  for (int k = 0; k < kBits; ++k) {
+    if constexpr (std::is_integral_v<U>) {
+      if ((index >> k) == 0u) break;  // no higher bit set
+    }
+    result ^= column[k] & (0u - ((index >> k) & 1u));  // no branch on the bit
+  }
+  return result;
+}
+
+// A 32-bit integer hash (a two-multiply xorshift finaliser), for seeds.
+template <class U>
+PDFLAB_QMC U hash(U x) {
+  x ^= x >> 16;
+  x *= 0x21f0aaadu;
+  x ^= x >> 15;
+  x *= 0x735a2d97u;
+  return x ^ (x >> 15);
+}
+
+// Laine and Karras's permutation, applied to bit-reversed words: an addition
+// and products by even constants carry only towards the more significant bits,
+// so bit j of the result depends on bits j and below alone. On reversed words
+// that is a nested uniform (Owen) scramble: a bit of the value is flipped by a
+// hash of the bits above it.
+template <class U>
+PDFLAB_QMC U laine_karras(U v, U seed) {
+  v += seed;
+  v ^= v * 0x6c50b47cu;
+  v ^= v * 0xb82f1e52u;
+  v ^= v * 0xc7afe638u;
+  v ^= v * 0x8d22f6e6u;
+  return v;
+}
+
+// Owen scramble of v by `seed` (a bijection of [0, 2^32)).
+template <class U>
+PDFLAB_QMC U owen_scramble(U v, U seed) {
+  return reverse_bits(laine_karras(reverse_bits(v), seed));
+}
+
+// The stratified points are made from the low kIndexBits of the sample index;
+// each further block of 2^kIndexBits samples takes a scramble of its own.
+inline constexpr int kIndexBits = 16;
+
+// reverse_bits(sobol(i, dim)) for i below 2^kIndexBits: the columns reversed,
+// so that the scramble, which works on reversed words, needs no reversal first.
+struct ReversedDirections {
+  std::uint32_t column[2][kIndexBits]{};
+};
+constexpr ReversedDirections make_reversed_directions() {
+  ReversedDirections r;
+  for (int d = 0; d < 2; ++d)
+    for (int k = 0; k < kIndexBits; ++k) {
+      const std::uint32_t c = kDirections.column[d][k];
+      std::uint32_t v = 0;
+      for (int b = 0; b < kBits; ++b) v |= ((c >> b) & 1u) << (kBits - 1 - b);
+      r.column[d][k] = v;
+    }
+  return r;
+}
+inline constexpr ReversedDirections kReversedDirections = make_reversed_directions();
+
+template <class U>
+PDFLAB_QMC U sobol_reversed(U index, int dim) {
+  if (dim == 0) return index;  // van der Corput is the reversal itself
+  const std::uint32_t* column = kReversedDirections.column[dim - 1];
+  U result = index ^ index;  // zero, of U's type
+  for (int k = 0; k < kIndexBits; ++k) result ^= column[k] & (0u - ((index >> k) & 1u));
+  return result;
+}
+
+// What each draw group of a vertex is, for its seed.
+enum class Group : std::uint32_t { Continuation = 0, Light = 1, Specular = 2 };
+// The vertices (by path depth: the camera ray is segment 0) whose draws are
+// stratified; the draws of deeper vertices stay independent.
+inline constexpr int kDepths = 2;
+
+// The seed of draw group `group` at the vertex reached by segment `depth` of a
+// sample whose pixel seed is `pixel_seed`.
+template <class U>
+PDFLAB_QMC U group_seed(U pixel_seed, U depth, Group group) {
+  return hash(pixel_seed ^ hash(depth * 4u + (static_cast<std::uint32_t>(group) + 1u)));
+}
+
+// The group's point for sample `index` of the pixel: `dims` (at most three)
+// dimensions of an Owen-scrambled Sobol point at the group's shuffled index
+// (Burley's padding: the index itself Owen-scrambled by the seed), as 32 bits
+// each (bits >> 8 scaled by 2^-24 is the uniform in [0, 1), Rng::to_unit).
+// Dimensions 0 and 1 form a (0,2)-sequence; with dimension 2 the three form a
+// (1,3)-sequence. The shuffle keeps every block of 2^k consecutive indices
+// (k <= kIndexBits) a block of 2^k indices of the sequence, up to bits below
+// the 2^-k strata that the value's scramble randomises anyway.
+template <class U>
+struct Point {
+  U dim[3];
+};
+template <class U>
+PDFLAB_QMC Point<U> point(U index, U seed, int dims = 3) {
+  seed = hash(seed ^ (index >> kIndexBits));
+  // The shuffled index, its low kIndexBits bits only (the others are the
+  // seed's, the same for every sample of the block).
+  const U shuffled = reverse_bits(laine_karras(reverse_bits(index), seed)) & ((1u << kIndexBits) - 1u);
+  Point<U> p{};
+  for (int d = 0; d < dims; ++d)
+    p.dim[d] = reverse_bits(laine_karras(sobol_reversed(shuffled, d), hash(seed + 0x9e3779b9u * (d + 1u))));
+  return p;
+}
+
+// The point of draw group `group` at the vertex reached by segment `depth`,
+// for sample `index` of the pixel whose seed is `pixel_seed` (Rng::qmc_*).
+template <class U>
+PDFLAB_QMC Point<U> group_point(U index, U pixel_seed, U depth, Group group, int dims) {
+  return point(index, group_seed(pixel_seed, depth, group), dims);
+}
+
+}  // namespace pdflab::qmc
