@@ -323,6 +323,7 @@ int run_render(const RenderOptions& o) {
     j["strategy"] = strategy.to_string();
     j["unbiased"] = strategy.is_unbiased();
     j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
+    j["sampler"] = strategy.sobol ? "sobol" : "independent";  // +sobol
     if (strategy.fastest) j["expanded_from"] = "fastest";
     j["width"] = final_info.width;
     j["height"] = final_info.height;

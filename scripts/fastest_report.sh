@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # The table that chooses `fastest`: each candidate's efficiency at equal time
 # against the book's mixture, seed by seed, on the shipped scenes (or those in
-# SCENES), against a reference with REF_FACTOR (48) times the samples per pixel
-# of the fastest candidate in a calibration run. Prints one markdown row per
-# scene and candidate (mean ratio and its 95% t interval over the seeds), the
-# reference's multiple of the most-sampled run actually measured, and the load
-# average before and after each scene; keeps the CSVs in OUT.
+# SCENES). A calibration run gives every candidate SECONDS_PER_RUN; each then
+# renders the samples per pixel it reached there, with every seed, so the
+# reference, with REF_FACTOR (48) times the most of them, has exactly that
+# multiple of the most-sampled run whatever the machine's load does meanwhile
+# (efficiency is 1 / (relMSE x the run's own time)). Prints one markdown row
+# per scene and candidate (mean ratio and its 95% t interval over the seeds),
+# the reference's multiple and the load average before and after each scene;
+# keeps the CSVs in OUT.
 #   bash scripts/fastest_report.sh                           # 100x100, 2 s runs, 4 seeds: about 15 min on 2 cores
 #   SIZE=600 SECONDS_PER_RUN=5 SCENES=cornell_book bash scripts/fastest_report.sh
 # Settings (environment): PDFLAB (binary), SIZE (100), SECONDS_PER_RUN (2), SEEDS (4: seeds 2, 3, ...),
@@ -51,11 +54,16 @@ for scene in "${SCENES[@]}"; do
   "$PDFLAB" reference --scene "$file" --width "$SIZE" --height "$SIZE" --spp "$ref_spp" --strategy "$ref_strategy" \
     --threads "$THREADS" --cache-dir "$OUT/cache" --out "$OUT/$scene.pfm" --quiet >&2
   : >"$OUT/$scene.tsv"
+  mapfile -t calibrated < <(rows "$OUT/$scene.calibration.csv" | cut -f1,2)
   for ((k = 0; k < SEEDS; ++k)); do
     seed=$((2 + k))
-    "$PDFLAB" bench --scene "$file" --strategies "$CANDIDATES" --seconds "$SECONDS_PER_RUN" --seed "$seed" \
-      --reference "$OUT/$scene.pfm" --threads "$THREADS" --quiet --csv "$OUT/$scene.$seed.csv" >/dev/null
-    rows "$OUT/$scene.$seed.csv" | awk -v seed="$seed" '{ print seed "\t" $0 }' >>"$OUT/$scene.tsv"
+    for ((c = 0; c < ${#calibrated[@]}; ++c)); do
+      strategy=${calibrated[c]%%$'\t'*}
+      spp=${calibrated[c]##*$'\t'}
+      "$PDFLAB" bench --scene "$file" --strategies "$strategy" --spp "$spp" --seed "$seed" \
+        --reference "$OUT/$scene.pfm" --threads "$THREADS" --quiet --csv "$OUT/$scene.$seed.$c.csv" >/dev/null
+      rows "$OUT/$scene.$seed.$c.csv" | awk -v seed="$seed" '{ print seed "\t" $0 }' >>"$OUT/$scene.tsv"
+    done
   done
   load_after=$(cut -d' ' -f1-3 /proc/loadavg)
   awk -F '\t' -v scene="$scene" -v ref_spp="$ref_spp" -v lb="$load_before" -v la="$load_after" -v size="$SIZE" '

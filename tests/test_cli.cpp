@@ -177,6 +177,7 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   EXPECT_EQ(stats.at("seed").get<int>(), 5);
   EXPECT_EQ(stats.at("threads").get<int>(), 2);
   EXPECT_EQ(stats.at("strategy").get<std::string>(), "mix:cosine=0.5,light=0.5");
+  EXPECT_EQ(stats.at("sampler").get<std::string>(), "independent");
   EXPECT_EQ(stats.at("samples").get<std::uint64_t>(), 32u * 32u * 4u);
   const double seconds = stats.at("seconds").get<double>();
   const double rate = stats.at("samples_per_second").get<double>();
@@ -195,6 +196,17 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   static const std::regex summary(R"(^4 spp, 32x32, [0-9.]+ s, [0-9.]+ M samples/s, 2 threads, [0-9]+ samples dropped[^\n]*\nest\. relMSE [^\n]*\n$)");
   EXPECT_TRUE(std::regex_search(r.out, summary)) << "stdout: " << r.out;
   EXPECT_NE(r.out.find(", " + std::to_string(sum) + " samples dropped"), std::string::npos) << r.out;
+}
+
+TEST_F(RenderCommand, StatsJsonRecordsTheSobolSampler) {
+  std::vector<std::string> a = small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json")});
+  a[4] = "nee-mis+sobol+rr";  // the --strategy value
+  const ChildResult r = run(a);
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(work() / "stats.json"));
+  EXPECT_EQ(stats.at("strategy").get<std::string>(), "nee-mis+sobol+rr");
+  EXPECT_EQ(stats.at("sampler").get<std::string>(), "sobol");
 }
 
 TEST_F(RenderCommand, RendersPng) {

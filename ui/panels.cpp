@@ -224,6 +224,11 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
     ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
     ImGui::SliderInt("from depth", &s.roulette_depth, 1, 20, "%d", ImGuiSliderFlags_AlwaysClamp);
   }
+  // The stratified sampler, for any strategy.
+  ImGui::Checkbox("Sobol sampler", &s.sobol);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("The first two vertices' random numbers from Owen-scrambled Sobol points, stratified\n"
+                      "across each pixel's samples (+sobol); off: every number independent");
 
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;

@@ -42,6 +42,7 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
                       d.spp, d.seconds, d.version});
   j["unbiased"] = d.strategy.is_unbiased();
   j["russian_roulette_depth"] = d.strategy.roulette_depth;  // 0: off
+  j["sampler"] = d.strategy.sobol ? "sobol" : "independent";  // +sobol
   if (d.strategy.fastest) j["expanded_from"] = "fastest";
   double total = 0.0;
   for (float w : d.strategy.weights) total += w;

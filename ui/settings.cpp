@@ -13,6 +13,7 @@ Strategy SamplingSettings::strategy() const {
   }
   s.parameters = parameters;
   s.roulette_depth = roulette_depth;
+  s.sobol = sobol;
   s.fastest = fastest && s == fastest_sampling().strategy_without_name();
   return s;
 }
@@ -33,6 +34,7 @@ SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   SamplingSettings out;
   out.parameters = strategy.parameters;
   out.roulette_depth = strategy.roulette_depth;
+  out.sobol = strategy.sobol;
   out.fastest = strategy.fastest;
   if (strategy.nee_mis) {
     out.nee_mis = true;

@@ -29,6 +29,7 @@ struct SamplingSettings {
   // such as `fastest` set another).
   std::array<float, kTechniqueCount> continuation = Strategy::nee().weights;
   int roulette_depth = 0;  // Strategy::roulette_depth, for any of the above
+  bool sobol = false;      // Strategy::sobol (the stratified sampler), for any of the above
   bool fastest = false;    // the `fastest` preset, as it expands
 
   Strategy strategy() const;
