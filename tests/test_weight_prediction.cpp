@@ -373,33 +373,6 @@ TEST(CostFit, PricedCurveIsWhatAutoWeightChoosesFrom) {
   EXPECT_GT(std::fabs(rays_only.best_weight() - curve.best_weight()), 0.03);
 }
 
-// The relative variance's standard error (one cell, a shared denominator)
-// is the spread of the prediction itself over independent draws.
-TEST(WeightPrediction, StandardErrorIsThePredictionsSpread) {
-  const Mixture m;
-  const std::vector<double> grid = pdflab::weight_grid(11);
-  const double mu = integrate(f);
-  const std::vector<float> mean = {static_cast<float>(mu), static_cast<float>(mu), static_cast<float>(mu)};
-  for (std::size_t g : {std::size_t{3}, std::size_t{6}, std::size_t{9}}) {
-    std::vector<double> values;
-    double error = 0.0;
-    constexpr int kDraws = 200;
-    for (int k = 0; k < kDraws; ++k) {
-      const pdflab::WeightPrediction p = draw(m, 0.5, 2000, 100 + static_cast<std::uint64_t>(k), grid).predict(mean, 0.0, 0.01);
-      ASSERT_EQ(p.relative_variance_error.size(), grid.size());
-      values.push_back(p.relative_variance[g]);
-      error += p.relative_variance_error[g] / kDraws;
-    }
-    double m1 = 0.0, m2 = 0.0;
-    for (double v : values) m1 += v / kDraws;
-    for (double v : values) m2 += (v - m1) * (v - m1) / (kDraws - 1);
-    EXPECT_NEAR(error, std::sqrt(m2), 0.2 * std::sqrt(m2)) << grid[g];
-  }
-  // Channels with different denominators: no error is claimed.
-  const std::vector<float> uneven = {static_cast<float>(mu), 0.5f * static_cast<float>(mu), static_cast<float>(mu)};
-  EXPECT_TRUE(draw(m, 0.5, 100, 1, grid).predict(uneven, 0.0, 0.01).relative_variance_error.empty());
-}
-
 TEST(WeightPrediction, ForecastSeedIsAnotherSeed) {
   for (std::uint64_t seed : {0ull, 1ull, 2ull, 0x9e3779b97f4a7c15ull, ~0ull}) {
     EXPECT_NE(pdflab::forecast_seed(seed), seed);

@@ -249,34 +249,24 @@ void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per
     model_ = fit_.fit(prior_offset_, kFitSpread);
   }
   // The passes' predictions pooled, each counted by its paths: at every w'
-  // the relative variance, its standard error and the rays (each pass's is an
-  // estimate of the same quantity, whatever weight its paths were drawn at).
-  // Pooling the variance, not averaging the passes' efficiencies: 1 / V is
-  // convex, and a pass whose V came out near 0 somewhere would outvote the rest.
+  // the relative variance and the rays (each pass's is an estimate of the
+  // same quantity, whatever weight its paths were drawn at). Pooling the
+  // variance, not averaging the passes' efficiencies: 1 / V is convex, and a
+  // pass whose V came out near 0 somewhere would outvote the rest.
   const std::size_t n = grid_.size();
-  std::vector<double> variance(n, 0.0), error2(n, 0.0), rays(n, 0.0);
+  std::vector<double> variance(n, 0.0), rays(n, 0.0);
   double paths = 0.0;
   for (const WeightPrediction& p : passes_) {
     const double k = static_cast<double>(p.paths);
     paths += k;
-    for (std::size_t g = 0; g < n; ++g) {
-      variance[g] += k * p.relative_variance[g];
-      rays[g] += k * p.cost[g];
-      const double e = p.relative_variance_error.size() == n ? p.relative_variance_error[g] : 0.0;
-      error2[g] += k * k * e * e;
-    }
+    for (std::size_t g = 0; g < n; ++g) variance[g] += k * p.relative_variance[g], rays[g] += k * p.cost[g];
   }
   // Without timing: rays alone.
   const CostModel model = model_.per_ray > 0.0 ? model_ : CostModel{0.0, 1.0, false};
-  // The next weight: the best efficiency at one standard error above the
-  // pooled variance. Far from the weights drawn so far, and after few paths,
-  // the prediction rests on few paths with large ratios; the cautious choice
-  // does not follow a curve there that one lucky path has bent.
   std::size_t best = n;
   double best_value = 0.0;
   for (std::size_t g = 0; g < n && paths > 0.0; ++g) {
-    const double cautious = (variance[g] + std::sqrt(error2[g])) / paths;
-    const double value = 1.0 / (cautious * model.seconds(rays[g] / paths));
+    const double value = 1.0 / (variance[g] / paths * model.seconds(rays[g] / paths));
     if (std::isfinite(value) && value > best_value) best_value = value, best = g;
   }
   history_.push_back(best < n ? defended_weight(grid_[best]) : history_.back());

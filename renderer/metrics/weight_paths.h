@@ -119,7 +119,7 @@ std::uint64_t forecast_seed(std::uint64_t render_seed);
 // prediction (replay_samples: about 1/32 of the pass, 1 to 8: predicting
 // costs several per cent of a short run, less of a long one), and the next
 // weight is the best of the passes' predictions so far, pooled (each counted
-// by its number of paths) and taken cautiously (see add_pass).
+// by its number of paths; see add_pass).
 //
 // The time a weight costs comes from a CostModel (weight_prediction.h) fitted
 // to the passes' own timing: each pass gives its seconds per sample and its
@@ -144,8 +144,7 @@ class AutoWeight {
   // sample (one sample in every cell; 0: unknown, rays alone price it): the
   // next weight is the best of the passes' pooled prediction (relative
   // variance and rays, each pass counted by its paths) under the cost model
-  // fitted so far, with the variance taken one standard error high (where the
-  // prediction has one: predict_image_wide), kept inside the defensive floor.
+  // fitted so far, kept inside the defensive floor.
   void add_pass(const WeightPrediction& prediction, double seconds_per_sample = 0.0);
   // `prediction` priced as add_pass prices the passes: by the cost model
   // fitted to the passes so far or, before a fit, by its own seconds per

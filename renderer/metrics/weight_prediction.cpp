@@ -27,7 +27,6 @@ WeightPredictor::WeightPredictor(int cells, std::vector<double> grid, double sam
   moment_.assign(static_cast<std::size_t>(cells_) * grid_.size() * 3, 0.0);
   cost_sum_.assign(grid_.size(), 0.0);
   offset_sum_.assign(grid_.size(), 0.0);
-  square_sum_.assign(grid_.size(), 0.0);
   ratio_.assign(grid_.size(), 1.0);
 }
 
@@ -36,7 +35,6 @@ void WeightPredictor::clear() {
   std::fill(moment_.begin(), moment_.end(), 0.0);
   std::fill(cost_sum_.begin(), cost_sum_.end(), 0.0);
   std::fill(offset_sum_.begin(), offset_sum_.end(), 0.0);
-  std::fill(square_sum_.begin(), square_sum_.end(), 0.0);
   plain_cost_sum_ = 0.0;
   paths_ = 0;
 }
@@ -57,15 +55,10 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
   double* moment = &moment_[(static_cast<std::size_t>(cell) * grid_size) * 3];
   for (std::size_t g = 0; g < grid_size; ++g) {
     const double r = ratio_[g];
-    double path_moment = 0.0;
     for (int c = 0; c < 3; ++c) {
       const double f = static_cast<double>(rgb[c]);
-      if (f != 0.0) {  // 0 * inf stays out
-        moment[g * 3 + static_cast<std::size_t>(c)] += f * f * r;
-        path_moment += f * f * r;
-      }
+      if (f != 0.0) moment[g * 3 + static_cast<std::size_t>(c)] += f * f * r;  // 0 * inf stays out
     }
-    square_sum_[g] += path_moment * path_moment;
     const double inverse = 1.0 / r;  // 0 for an infinite ratio
     cost_sum_[g] += cost * inverse;
     offset_sum_[g] += inverse;
@@ -80,8 +73,7 @@ void WeightPredictor::merge(const WeightPredictor& o) {
     throw InputError("weight predictors with different cells, grids or weights cannot be merged");
   for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
   for (std::size_t i = 0; i < moment_.size(); ++i) moment_[i] += o.moment_[i];
-  for (std::size_t g = 0; g < grid_.size(); ++g)
-    cost_sum_[g] += o.cost_sum_[g], offset_sum_[g] += o.offset_sum_[g], square_sum_[g] += o.square_sum_[g];
+  for (std::size_t g = 0; g < grid_.size(); ++g) cost_sum_[g] += o.cost_sum_[g], offset_sum_[g] += o.offset_sum_[g];
   plain_cost_sum_ += o.plain_cost_sum_;
   paths_ += o.paths_;
 }
@@ -123,24 +115,6 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
     }
   }
   if (terms == 0 || paths_ == 0) return p;
-  // One cell whose channels share a denominator: the relative variance is
-  // the mean over paths of X = sum_c F_c^2 R / (3 d) less a constant, so its
-  // standard error is X's over sqrt(paths).
-  if (cells_ == 1 && paths_ >= 2) {
-    const double d = static_cast<double>(mean_rgb[0]) * mean_rgb[0] + epsilon;
-    bool shared = d > 0.0;
-    for (int c = 1; c < 3; ++c)
-      shared = shared && static_cast<double>(mean_rgb[static_cast<std::size_t>(c)]) * mean_rgb[static_cast<std::size_t>(c)] + epsilon == d;
-    if (shared) {
-      const double n = static_cast<double>(paths_);
-      p.relative_variance_error.assign(grid_size, 0.0);
-      for (std::size_t g = 0; g < grid_size; ++g) {
-        const double sum = moment_[g * 3] + moment_[g * 3 + 1] + moment_[g * 3 + 2];
-        const double spread = std::max(0.0, square_sum_[g] / n - (sum / n) * (sum / n));
-        p.relative_variance_error[g] = std::sqrt(spread * n / (n - 1.0) / n) / (3.0 * d);
-      }
-    }
-  }
   // Cost at w' self-normalised by the mean of 1/R (whose expectation is 1): the
   // ratio estimate has less noise than the plain mean when R varies a lot. The
   // measured time per sample belongs to the plain mean cost at the sampling weight.

@@ -62,10 +62,6 @@ double defended_weight(double w, double floor = kDefensiveFloor);
 struct WeightPrediction {
   std::vector<double> weight;           // the grid
   std::vector<double> relative_variance;  // mean over pixels and channels of var / (mu^2 + eps), one sample each
-  // The standard error of relative_variance from the paths' spread, for a
-  // predictor of one cell whose channels share a denominator (as
-  // predict_image_wide's); empty otherwise.
-  std::vector<double> relative_variance_error;
   std::vector<double> cost;             // expected cost of a path (segments traced)
   std::vector<double> efficiency;       // 1 / (relative_variance * seconds per pass); 0 where infinite variance
   std::uint64_t paths = 0;
@@ -157,7 +153,6 @@ class WeightPredictor {
   std::vector<double> moment_;         // per cell, grid point and channel: sum of F^2 R
   std::vector<double> cost_sum_;       // per grid point: sum of cost / R
   std::vector<double> offset_sum_;     // per grid point: sum of 1 / R (should approach the path count)
-  std::vector<double> square_sum_;     // per grid point: sum over paths of (sum over channels of F^2 R)^2
   double plain_cost_sum_ = 0.0;        // sum of cost, at the sampling weight
   std::vector<double> ratio_;          // scratch: R per grid point for the path being added
   std::uint64_t paths_ = 0;
