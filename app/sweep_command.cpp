@@ -257,7 +257,7 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
 // predicted second moment (relative to the reference, as relMSE weighs it), on
 // a blue (0: all B) - white (0.5) - red (1: all A) scale, `scale` x enlarged,
 // with the scale as a bar underneath; grey where no recorded path carried
-// light. Pixels as linear values that the PNG writer's gamma-2 curve maps to
+// light or w does not matter. Pixels as linear values that the PNG writer's gamma-2 curve maps to
 // the intended colours.
 std::vector<std::uint8_t> best_weight_png(const WeightPredictor& predictor, const std::vector<float>& reference,
                                           int width, int height) {
@@ -282,10 +282,16 @@ std::vector<std::uint8_t> best_weight_png(const WeightPredictor& predictor, cons
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const int cell = y * width + x;
-      double moment = 0.0;
-      for (int c = 0; c < 3; ++c) moment += predictor.second_moment(cell, 0, c) + predictor.second_moment(cell, predictor.grid().size() - 1, c);
+      // Grey also where the moment does not depend on w (a light seen
+      // directly, through no diffuse vertex), as the viewer's map.
+      double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+      for (std::size_t g = 0; g < predictor.grid().size(); ++g) {
+        double moment = 0.0;
+        for (int c = 0; c < 3; ++c) moment += predictor.second_moment(cell, g, c);
+        lo = std::min(lo, moment), hi = std::max(hi, moment);
+      }
       float c[3] = {0.25f, 0.25f, 0.25f};
-      if (moment > 0.0 && best[static_cast<std::size_t>(cell)] >= 0.0f) colour(best[static_cast<std::size_t>(cell)], c);
+      if (hi > lo * (1.0 + 1e-6) && best[static_cast<std::size_t>(cell)] >= 0.0f) colour(best[static_cast<std::size_t>(cell)], c);
       for (int dy = 0; dy < kScale; ++dy)
         for (int dx = 0; dx < kScale; ++dx) put(x * kScale + dx, y * kScale + dy, c);
     }
@@ -668,7 +674,7 @@ int run_sweep(const SweepOptions& o) {
     PlotOptions po;
     po.title = "Efficiency against the weight of " + family.a + " (vs " + family.b + "): " + scene->name;
     po.x_label = "weight of " + family.a + " (share of " + family.a + " + " + family.b + ")";
-    po.y_label = "efficiency = 1 / (relMSE * seconds)";
+    po.y_label = o.cpu_time ? "efficiency = 1 / (relMSE * CPU seconds)" : "efficiency = 1 / (relMSE * seconds)";
     po.width = 900;
     po.height = 520;
     po.x_min = weights.front();
