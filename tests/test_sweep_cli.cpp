@@ -263,3 +263,27 @@ TEST_F(SweepCommand, AutoWeightAddsARow) {
 }
 
 }  // namespace
+
+namespace {
+
+// --cpu-time prices the runs by the process's CPU time: every row gets a time
+// per sample and the pooled efficiency from it, and stdout says which clock
+// priced the runs and what the load was.
+TEST_F(SweepCommand, CpuTimePricesTheRuns) {
+  make_reference();
+  const ChildResult r = run(sweep_args({"--vary", "cosine,light", "--weights", "0.25:0.75:0.5", "--spp", "16",
+                                        "--seeds", "2", "--cpu-time"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> header;
+  const auto rows = read_csv(slurp(in_work("out.csv")), header);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_GT(number(row, "seconds_per_sample"), 0.0);
+    EXPECT_NEAR(number(row, "efficiency"), 1.0 / (number(row, "relmse_per_sample") * number(row, "seconds_per_sample")),
+                1e-4 * number(row, "efficiency"));
+  }
+  EXPECT_NE(r.out.find("runs priced by their CPU time"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("load average (1 min)"), std::string::npos) << r.out;
+}
+
+}  // namespace
