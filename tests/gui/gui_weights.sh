@@ -39,9 +39,10 @@ awk -v c="$cosine" -v l="$light" 'BEGIN { w = c / (c + l); print "final w", w; e
 
 echo "== the weight views"
 start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
-sleep 1
+# The first look as soon as the window is up: the curve's prediction starts
+# with the first pass, so a later first look may already show a settled curve.
 import -window "$wid" "$art/panel_early.png"
-sleep 6
+sleep 7
 area=$((WIDTH - 400))
 side=$(( area < HEIGHT ? area : HEIGHT ))
 crop="$((side - 40))x$((side - 40))+$((20 + (area - side) / 2))+$((20 + (HEIGHT - side) / 2))"
