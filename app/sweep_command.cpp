@@ -507,7 +507,7 @@ int run_sweep(const SweepOptions& o) {
   // sample against the rays per sample that the pilot's paths predict at its
   // weight. The rows' weights spread the rays, so their times tell the fixed
   // cost per sample from the cost per ray. The prediction is then re-priced
-  // by it; `rays_only` keeps the curve of a cost of rays alone.
+  // by it.
   auto grid_index = [&](double w) {
     return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
   };
@@ -522,7 +522,6 @@ int run_sweep(const SweepOptions& o) {
     cost_fit.add(rays, row_seconds_per_sample[i]);
   }
   const CostModel cost_model = cost_fit.fit(AutoWeight::kPriorOffset);
-  std::vector<WeightPrediction> rays_only = predictions;
   if (cost_model.per_ray > 0.0)
     for (WeightPrediction& p : predictions) apply_cost_model(p, cost_model);
 
@@ -753,14 +752,14 @@ int run_sweep(const SweepOptions& o) {
     std::printf("predicted best weight (from the paths at %.3g, %zu seeds pooled): %.3g; each seed's alone: %.3g +- %.2g\n",
                 rows[static_cast<std::size_t>(pilot)].weight, predictions.size(), predicted_optimum.mean,
                 interval(predicted_best).mean, predicted_optimum.half);
+  else
+    std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
+                1.0 - kDefensiveFloor);
   if (gap_rows > 0)
     std::printf("predicted relative efficiency against measured, %d weights in [0.1, 0.9]: largest gap %.0f%% (at %.3g); "
                 "%.0f%% (at %.3g) where measured is at least 0.3 of its peak; inside the measured 95%% interval at %d of %d\n",
                 gap_rows, 100.0 * gap_all.value, gap_all.at, 100.0 * std::max(0.0, gap_high.value), gap_high.at,
                 gap_inside, gap_rows);
-  else
-    std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
-                1.0 - kDefensiveFloor);
   std::printf("load average (1 min): %.2f at the start, %.2f at the end; runs priced by %s\n", load_at_start,
               load_average(), o.cpu_time ? "their CPU time (--cpu-time)" : "the wall clock");
   return 0;
