@@ -156,12 +156,6 @@ SPLIT_ROW='
       for (i = 1; i <= m; ++i) f[n + i] = tail[i]
       return n + m
     }
-    # 95% two-sided Student t quantile for k - 1 degrees of freedom.
-    function t95(k) {
-      if (k <= 2) return 12.706; if (k == 3) return 4.303; if (k == 4) return 3.182; if (k == 5) return 2.776
-      if (k == 6) return 2.571; if (k == 7) return 2.447; if (k == 8) return 2.365; if (k <= 11) return 2.262
-      if (k <= 21) return 2.086; return 1.96
-    }
 '
 
 # The per-scene figures, one line per strategy (in the order run), tab-separated:
@@ -169,7 +163,7 @@ SPLIT_ROW='
 # Means over the seeds; *_ci are 95% t calibration_seconds widths over them; the ratio to
 # cosine is taken seed by seed (independent runs) and averaged.
 aggregate() {
-  awk "$SPLIT_ROW"'
+  awk "$SPLIT_ROW$(<scripts/student_t.awk)"'
     NR == 1 { for (i = 1; i <= split($0, h, ","); ++i) col[h[i]] = i; next }
     {
       split_row($0, f)

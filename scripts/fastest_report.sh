@@ -28,7 +28,7 @@ CANDIDATES=${CANDIDATES:-"mix:cosine=0.5,light=0.5;mix:cosine=0.5,light=0.5+sobo
 die() { echo "fastest_report: $*" >&2; exit 2; }
 [[ -x $PDFLAB ]] || die "no binary at $PDFLAB"
 [[ $REF_FACTOR =~ ^[0-9]+$ ]] && (( REF_FACTOR >= 32 )) || die "REF_FACTOR must be a whole number of at least 32"
-(( SEEDS >= 2 )) || die "SEEDS must be at least 2"
+[[ $SEEDS =~ ^[0-9]+$ ]] && (( SEEDS >= 2 )) || die "SEEDS must be a whole number of at least 2"
 if [[ -n ${SCENES:-} ]]; then read -r -a SCENES <<<"$SCENES"; else
   SCENES=()
   for f in assets/scenes/*.json; do SCENES+=("$(basename "$f" .json)"); done
@@ -66,8 +66,7 @@ for scene in "${SCENES[@]}"; do
     done
   done
   load_after=$(cut -d' ' -f1-3 /proc/loadavg)
-  awk -F '\t' -v scene="$scene" -v ref_spp="$ref_spp" -v lb="$load_before" -v la="$load_after" -v size="$SIZE" '
-    function t95(k) { return k <= 2 ? 12.706 : k == 3 ? 4.303 : k == 4 ? 3.182 : k == 5 ? 2.776 : k == 6 ? 2.571 : 2.447 }
+  awk -F '\t' -v scene="$scene" -v ref_spp="$ref_spp" -v lb="$load_before" -v la="$load_after" -v size="$SIZE" "$(<scripts/student_t.awk)"'
     NR == 1 { first = $2 }
     $2 == first { base[$1] = $5 }
     { if (!($2 in seen)) { seen[$2] = 1; order[++n] = $2 } eff[$2, $1] = $5; spp[$2] += $3; cnt[$2]++; if ($3 > most) most = $3; seeds[$1] = 1 }
@@ -75,6 +74,7 @@ for scene in "${SCENES[@]}"; do
       for (i = 1; i <= n; ++i) {
         s = order[i]; sum = 0; sq = 0; k = 0
         for (seed in seeds) if (base[seed] > 0) { q = eff[s, seed] / base[seed]; sum += q; sq += q * q; ++k }
+        if (k == 0) { printf "| %s | `%s` | | no seed of the book mixture has an efficiency |\n", scene, s; continue }
         m = sum / k; v = k > 1 ? (sq - k * m * m) / (k - 1) : 0; h = t95(k) * sqrt(v > 0 ? v : 0) / sqrt(k)
         printf "| %s | `%s` | %.0f | %.2fx [%.2f, %.2f] |\n", scene, s, spp[s] / cnt[s], m, (m - h > 0 ? m - h : 0), m + h
       }
