@@ -254,8 +254,7 @@ PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, 
   const std::uint64_t scramble = mix64(seed.scramble_key + pixel);
   const std::uint32_t sx = qmc::sobol(sample_index, 0) ^ static_cast<std::uint32_t>(scramble);
   const std::uint32_t sy = qmc::sobol(sample_index, 1) ^ static_cast<std::uint32_t>(scramble >> 32);
-  const float jx = static_cast<float>(sx >> 8) * 0x1.0p-24f;
-  const float jy = static_cast<float>(sy >> 8) * 0x1.0p-24f;
+  const float jx = Rng::to_unit(sx), jy = Rng::to_unit(sy);
   PixelSampleStart start{scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
                          Rng::for_sample_keyed(seed.rng_key, pixel, sample_index)};
   start.rng.qmc_index = sample_index;

@@ -30,12 +30,12 @@
 
 namespace pdflab::qmc {
 
-// How many bits a dimension of the point has, and the largest power of two of
-// samples whose stratification it carries in full.
+// How many bits a dimension of the point has (the word's width; how many
+// samples are stratified in full is kIndexBits, below).
 inline constexpr int kBits = 32;
 
 template <class U>
-PDFLAB_QMC U reverse_bits(U v) {
+PDFLAB_QMC constexpr U reverse_bits(U v) {
   v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
   v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
   v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
@@ -122,12 +122,7 @@ struct ReversedDirections {
 constexpr ReversedDirections make_reversed_directions() {
   ReversedDirections r;
   for (int d = 0; d < 2; ++d)
-    for (int k = 0; k < kIndexBits; ++k) {
-      const std::uint32_t c = kDirections.column[d][k];
-      std::uint32_t v = 0;
-      for (int b = 0; b < kBits; ++b) v |= ((c >> b) & 1u) << (kBits - 1 - b);
-      r.column[d][k] = v;
-    }
+    for (int k = 0; k < kIndexBits; ++k) r.column[d][k] = reverse_bits(kDirections.column[d][k]);
   return r;
 }
 inline constexpr ReversedDirections kReversedDirections = make_reversed_directions();
@@ -171,7 +166,7 @@ PDFLAB_QMC Point<U> point(U index, U seed, int dims = 3) {
   seed = hash(seed ^ (index >> kIndexBits));
   // The shuffled index, its low kIndexBits bits only (the others are the
   // seed's, the same for every sample of the block).
-  const U shuffled = reverse_bits(laine_karras(reverse_bits(index), seed)) & ((1u << kIndexBits) - 1u);
+  const U shuffled = owen_scramble(index, seed) & ((1u << kIndexBits) - 1u);
   Point<U> p{};
   for (int d = 0; d < dims; ++d)
     p.dim[d] = reverse_bits(laine_karras(sobol_reversed(shuffled, d), hash(seed + 0x9e3779b9u * (d + 1u))));
