@@ -167,9 +167,10 @@ Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strat
 }
 
 // Auto weight (weight_paths.h): the run is split into AutoWeight's passes
-// (1/16, 1/16, 1/8, 1/4, 1/2 of the time or spp); each pass renders at the
+// (1/32, 3/32, 1/8, 1/4, 1/2 of the time or spp); each pass renders at the
 // weight the passes before it predicted best, starting at 0.5, and the image
-// is their sample-weighted mean. After each pass but the last, the prediction
+// is their sample-weighted mean. After each pass but the last, until the
+// weight has settled (AutoWeight::settled), the prediction
 // traces the next few samples of the sequence with the pass's weight through
 // the one-path tracer, which records their vertices; they are added to the
 // image, and their time counts against the run.
@@ -209,7 +210,9 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
     for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(image[i]) * r.spp;
     spp += r.spp;
     seconds += r.seconds;
-    if (pass + 1 == AutoWeight::kPasses || r.spp == 0) continue;
+    // A settled weight (two predictions agree) is kept without predicting
+    // again; the decision, like the weight, rests on earlier samples only.
+    if (pass + 1 == AutoWeight::kPasses || r.spp == 0 || chooser.settled()) continue;
     // The prediction knows what a render knows: the passes so far (their mean
     // image), not the reference. Its paths must not be among the samples of
     // that mean: a path that is also in its pixel's mean raises the mean with

@@ -373,6 +373,42 @@ TEST(CostFit, PricedCurveIsWhatAutoWeightChoosesFrom) {
   EXPECT_GT(std::fabs(rays_only.best_weight() - curve.best_weight()), 0.03);
 }
 
+// Auto weight stops predicting once two predictions in a row choose the same
+// weight; the first pass's weight is a guess, so one prediction that keeps it
+// does not settle anything, and a prediction that moves it unsettles it.
+TEST(CostFit, AutoWeightSettlesWhenTwoPredictionsAgree) {
+  const pdflab::AutoWeight probe(0.5, 21, 0.0);
+  const auto peaked = [&](double at) {  // one sample's relative variance least at `at`, rays 1 everywhere
+    pdflab::WeightPrediction p;
+    p.weight = probe.grid();
+    for (double w : p.weight) p.relative_variance.push_back(1.0 + 10.0 * (w - at) * (w - at));
+    p.cost.assign(p.weight.size(), 1.0);
+    p.efficiency.assign(p.weight.size(), 0.0);
+    p.paths = 1000;
+    p.sampling_cost = 1.0;
+    return p;
+  };
+  pdflab::AutoWeight kept(0.5, 21, 0.0);
+  kept.add_pass(peaked(0.5));
+  EXPECT_DOUBLE_EQ(kept.weight(), 0.5);
+  EXPECT_FALSE(kept.settled()) << "the first weight is a guess: one prediction agreeing with it settles nothing";
+  kept.add_pass(peaked(0.5));
+  EXPECT_TRUE(kept.settled());
+
+  pdflab::AutoWeight moved(0.5, 21, 0.0);
+  moved.add_pass(peaked(0.8));
+  EXPECT_DOUBLE_EQ(moved.weight(), 0.8);
+  EXPECT_FALSE(moved.settled());
+  moved.add_pass(peaked(0.8));
+  EXPECT_TRUE(moved.settled());
+  // A pass whose paths (ten times as many) put the best elsewhere moves the pooled best: not settled.
+  pdflab::WeightPrediction far = peaked(0.2);
+  far.paths = 10000;
+  moved.add_pass(far);
+  EXPECT_LT(moved.weight(), 0.5);
+  EXPECT_FALSE(moved.settled());
+}
+
 TEST(WeightPrediction, ForecastSeedIsAnotherSeed) {
   for (std::uint64_t seed : {0ull, 1ull, 2ull, 0x9e3779b97f4a7c15ull, ~0ull}) {
     EXPECT_NE(pdflab::forecast_seed(seed), seed);

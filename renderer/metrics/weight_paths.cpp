@@ -241,6 +241,12 @@ std::uint32_t AutoWeight::replay_samples(std::uint32_t pass_spp) {
 AutoWeight::AutoWeight(double first, int grid_points, double prior_offset)
     : grid_(weight_grid(grid_points)), prior_offset_(prior_offset), history_{defended_weight(first)} {}
 
+bool AutoWeight::settled() const {
+  // history_: the first guess, then one weight per prediction.
+  const std::size_t n = history_.size();
+  return n >= 3 && history_[n - 1] == history_[n - 2];
+}
+
 void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per_sample) {
   if (prediction.efficiency.size() != grid_.size()) return;
   passes_.push_back(prediction);

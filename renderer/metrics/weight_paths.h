@@ -119,7 +119,11 @@ std::uint64_t forecast_seed(std::uint64_t render_seed);
 // prediction (replay_samples: about 1/32 of the pass, 1 to 8: predicting
 // costs several per cent of a short run, less of a long one), and the next
 // weight is the best of the passes' predictions so far, pooled (each counted
-// by its number of paths; see add_pass).
+// by its number of paths; see add_pass). Once two predictions in a row choose
+// the same weight (settled()), the later passes keep it and trace no more
+// forecast paths: the forecast runs on the one-path tracer, several times
+// dearer a sample than the packet tracer, and on the shipped scenes a settled
+// weight moved by at most one grid step afterwards (docs/measuring.md).
 //
 // The time a weight costs comes from a CostModel (weight_prediction.h) fitted
 // to the passes' own timing: each pass gives its seconds per sample and its
@@ -140,6 +144,9 @@ class AutoWeight {
 
   explicit AutoWeight(double first = 0.5, int grid_points = 21, double prior_offset = kPriorOffset);
   double weight() const { return history_.back(); }  // for the next pass
+  // Whether the latest prediction kept the weight the one before it chose (the
+  // first pass's weight is a guess, not a choice): then predicting stops.
+  bool settled() const;
   // A finished pass's prediction (on grid()) and its measured seconds per
   // sample (one sample in every cell; 0: unknown, rays alone price it): the
   // next weight is the best of the passes' pooled prediction (relative
