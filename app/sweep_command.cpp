@@ -556,25 +556,22 @@ int run_sweep(const SweepOptions& o) {
   const BestFixed fair = fair_best_fixed(rows, relspp, per_sample, best);
 
   // The prediction on each row's weight and on the fine grid, pooled over the
-  // pilot's seeds as the measured rows are (not the mean of each seed's
-  // efficiency): the mean relative variance and the mean rays at each weight,
-  // priced by the cost model; `rays_only` by the pilot's time per ray.
+  // pilot's seeds (pooled_prediction) as the measured rows are, not the mean
+  // of each seed's efficiency; priced by the cost model, `rays_only` by the
+  // pilot's time per ray.
   const double pilot_seconds = pilot >= 0 ? row_seconds_per_sample[static_cast<std::size_t>(pilot)] : std::nan("");
-  std::vector<double> predicted_var(grid.size(), 0.0), predicted_rays(grid.size(), 0.0),
-      predicted_curve(grid.size(), 0.0), rays_only_curve(grid.size(), 0.0), predicted_best;
-  double pilot_rays = 0.0;
-  for (const WeightPrediction& p : predictions) {
-    const double n = static_cast<double>(predictions.size());
-    for (std::size_t g = 0; g < grid.size(); ++g) predicted_var[g] += p.relative_variance[g] / n, predicted_rays[g] += p.cost[g] / n;
-    pilot_rays += p.sampling_cost / n;
+  std::vector<double> predicted_best;
+  for (const WeightPrediction& p : predictions)
     if (p.best >= 0) predicted_best.push_back(p.best_weight());
-  }
+  const WeightPrediction pooled = pooled_prediction(predictions, cost_model);
+  WeightPrediction rays_only = pooled;
+  if (!predictions.empty()) apply_cost_model(rays_only, CostModel{0.0, pilot_seconds / pooled.sampling_cost, false});
+  const std::vector<double>& predicted_rays = pooled.cost;
+  const std::vector<double>& predicted_curve = pooled.efficiency;
   auto inverse = [](double d) { return std::isfinite(d) && d > 0.0 ? 1.0 / d : 0.0; };
   int predicted_top = -1;  // the pooled curve's best, inside the defensive floor
   double predicted_peak = 0.0;  // its maximum over the sweep's range, the measured peak's counterpart
   for (std::size_t g = 0; g < grid.size() && !predictions.empty(); ++g) {
-    predicted_curve[g] = inverse(predicted_var[g] * cost_model.seconds(predicted_rays[g]));
-    rays_only_curve[g] = inverse(predicted_var[g] * pilot_seconds * predicted_rays[g] / pilot_rays);
     if (defended_weight(grid[g]) == grid[g] &&
         (predicted_top < 0 || predicted_curve[g] > predicted_curve[static_cast<std::size_t>(predicted_top)]))
       predicted_top = static_cast<int>(g);
@@ -596,7 +593,7 @@ int run_sweep(const SweepOptions& o) {
     r.predicted.low = inverse(r.predicted_relmse_spp.hi() * seconds_here);
     r.predicted.high = r.predicted_relmse_spp.lo() > 0.0 ? inverse(r.predicted_relmse_spp.lo() * seconds_here)
                                                           : std::numeric_limits<double>::infinity();
-    r.predicted_rays_only = rays_only_curve[g];
+    r.predicted_rays_only = rays_only.efficiency[g];
   }
   Interval predicted_optimum = interval(predicted_best);
   predicted_optimum.mean = predicted_top >= 0 ? grid[static_cast<std::size_t>(predicted_top)] : std::nan("");

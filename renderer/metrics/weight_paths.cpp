@@ -254,28 +254,11 @@ void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per
     fit_.add(prediction.sampling_cost, seconds_per_sample);
     model_ = fit_.fit(prior_offset_, kFitSpread);
   }
-  // The passes' predictions pooled, each counted by its paths: at every w'
-  // the relative variance and the rays (each pass's is an estimate of the
-  // same quantity, whatever weight its paths were drawn at). Pooling the
-  // variance, not averaging the passes' efficiencies: 1 / V is convex, and a
-  // pass whose V came out near 0 somewhere would outvote the rest.
-  const std::size_t n = grid_.size();
-  std::vector<double> variance(n, 0.0), rays(n, 0.0);
-  double paths = 0.0;
-  for (const WeightPrediction& p : passes_) {
-    const double k = static_cast<double>(p.paths);
-    paths += k;
-    for (std::size_t g = 0; g < n; ++g) variance[g] += k * p.relative_variance[g], rays[g] += k * p.cost[g];
-  }
-  // Without timing: rays alone.
-  const CostModel model = model_.per_ray > 0.0 ? model_ : CostModel{0.0, 1.0, false};
-  std::size_t best = n;
-  double best_value = 0.0;
-  for (std::size_t g = 0; g < n && paths > 0.0; ++g) {
-    const double value = 1.0 / (variance[g] / paths * model.seconds(rays[g] / paths));
-    if (std::isfinite(value) && value > best_value) best_value = value, best = g;
-  }
-  history_.push_back(best < n ? defended_weight(grid_[best]) : history_.back());
+  // The passes' predictions pooled (pooled_prediction), priced by the model
+  // fitted so far or, without timing, by rays alone.
+  const WeightPrediction pooled =
+      pooled_prediction(passes_, model_.per_ray > 0.0 ? model_ : CostModel{0.0, 1.0, false});
+  history_.push_back(pooled.best >= 0 ? defended_weight(pooled.best_weight()) : history_.back());
 }
 
 }  // namespace pdflab

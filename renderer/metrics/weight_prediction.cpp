@@ -181,6 +181,30 @@ void apply_cost_model(WeightPrediction& p, const CostModel& model) {
   if (!(best > 0.0)) p.best = -1;
 }
 
+WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, const CostModel& model) {
+  WeightPrediction out;
+  if (parts.empty()) return out;
+  out.weight = parts.front().weight;
+  const std::size_t n = out.weight.size();
+  out.relative_variance.assign(n, 0.0);
+  out.cost.assign(n, 0.0);
+  out.efficiency.assign(n, 0.0);
+  double paths = 0.0;
+  for (const WeightPrediction& p : parts) {
+    if (p.weight != out.weight || p.relative_variance.size() != n || p.cost.size() != n) continue;
+    const double k = static_cast<double>(p.paths);
+    paths += k;
+    out.paths += p.paths;
+    out.sampling_cost += k * p.sampling_cost;
+    for (std::size_t g = 0; g < n; ++g) out.relative_variance[g] += k * p.relative_variance[g], out.cost[g] += k * p.cost[g];
+  }
+  if (!(paths > 0.0)) return out;
+  out.sampling_cost /= paths;
+  for (std::size_t g = 0; g < n; ++g) out.relative_variance[g] /= paths, out.cost[g] /= paths;
+  apply_cost_model(out, model);
+  return out;
+}
+
 std::vector<float> WeightPredictor::best_weight_map(const std::vector<float>& mean_rgb, double epsilon) const {
   if (mean_rgb.size() != static_cast<std::size_t>(cells_) * 3)
     throw InputError("weight prediction: the mean image does not have one RGB value per cell");

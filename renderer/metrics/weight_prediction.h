@@ -108,6 +108,15 @@ class CostFit {
 // efficiency's: seconds per sample of every cell gives a render's efficiency.
 void apply_cost_model(WeightPrediction& prediction, const CostModel& model);
 
+// Predictions from independent sets of paths (seeds, passes) on one grid,
+// pooled, each counted by its paths: at every weight the mean relative
+// variance and the mean rays (each part estimates the same quantities,
+// whatever weight its paths were drawn at), and the mean sampling cost; then
+// priced by `model` (apply_cost_model). Pooling the variance, not averaging
+// the parts' efficiencies: 1 / V is convex, and a part whose V came out near 0
+// somewhere would outvote the rest. Parts on another grid are skipped.
+WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, const CostModel& model);
+
 // Accumulates paths drawn at one sampling weight, per cell (a pixel, or a block
 // of pixels), and predicts over the grid. Not thread-safe: give each thread its
 // own and merge() them.
