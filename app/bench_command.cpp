@@ -236,7 +236,12 @@ int run_bench(const BenchOptions& o) {
         cost_fit.add(p.cost[static_cast<std::size_t>(g)], results[i].seconds / results[i].spp);
       }
     const double offset = std::clamp(cost_fit.fit(AutoWeight::kPriorOffset).offset(), 0.0, 10.0);
-    p = predictor.predict(reference.rgb, seconds_per_sample, kRelMseEpsilon, offset);
+    // Re-priced, not predicted again: the pilot's time per sample split with
+    // that fixed cost.
+    CostFit anchored;
+    anchored.add(p.sampling_cost, seconds_per_sample);
+    const CostModel model = anchored.fit(offset);
+    if (model.per_ray > 0.0) apply_cost_model(p, model);
     predicted_best = p.best_weight();
     for (std::size_t i = 0; i < results.size(); ++i)
       if (prediction.weights[i] >= 0.0) {
