@@ -285,16 +285,9 @@ std::vector<std::uint8_t> best_weight_png(const WeightPredictor& predictor, cons
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const int cell = y * width + x;
-      // Grey also where the moment does not depend on w (a light seen
-      // directly, through no diffuse vertex), as the viewer's map.
-      double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
-      for (std::size_t g = 0; g < predictor.grid().size(); ++g) {
-        double moment = 0.0;
-        for (int c = 0; c < 3; ++c) moment += predictor.second_moment(cell, g, c);
-        lo = std::min(lo, moment), hi = std::max(hi, moment);
-      }
       float c[3] = {0.25f, 0.25f, 0.25f};
-      if (hi > lo * (1.0 + 1e-6) && best[static_cast<std::size_t>(cell)] >= 0.0f) colour(best[static_cast<std::size_t>(cell)], c);
+      // Grey also where w does not matter (a light seen directly), as the viewer's map.
+      if (best[static_cast<std::size_t>(cell)] >= 0.0f) colour(best[static_cast<std::size_t>(cell)], c);
       for (int dy = 0; dy < kScale; ++dy)
         for (int dx = 0; dx < kScale; ++dx) put(x * kScale + dx, y * kScale + dy, c);
     }

@@ -40,18 +40,7 @@ WeightLab::Result WeightLab::run_round(Round& r) {
     }
   Result out;
   out.prediction = r.predictor->predict(mean, r.seconds_per_pass, kRelMseEpsilon, 0.0, &square);
-  out.best_weight = r.predictor->best_weight_map(mean, kRelMseEpsilon);
-  // A cell whose moment does not depend on w' (no light found, or only lights
-  // seen directly) has no best weight.
-  for (int cell = 0; cell < cells; ++cell) {
-    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
-    for (std::size_t g = 0; g < r.grid.size(); ++g) {
-      double moment = 0.0;
-      for (int c = 0; c < 3; ++c) moment += r.predictor->second_moment(cell, g, c);
-      lo = std::min(lo, moment), hi = std::max(hi, moment);
-    }
-    if (!(hi > lo * (1.0 + 1e-6))) out.best_weight[static_cast<std::size_t>(cell)] = -1.0f;
-  }
+  out.best_weight = r.predictor->best_weight_map(mean, kRelMseEpsilon);  // -1 where w does not matter
   // The technique shares per cell too: a pixel's few paths are mostly noise.
   std::vector<double> found(static_cast<std::size_t>(cells), 0.0), by_a(found.size(), 0.0);
   for (int y = 0; y < height; ++y)

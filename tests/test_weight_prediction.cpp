@@ -231,6 +231,28 @@ TEST(WeightPrediction, MergeEqualsOneAccumulation) {
 
 // A direction only B can draw has density 0 at w' = 1: the path could not
 // occur there, the second moment is infinite and that weight is never "best".
+// A cell whose paths pass no diffuse vertex (a light seen directly) has the
+// same moment at every weight: no best weight, as a cell without paths.
+TEST(WeightPrediction, BestWeightMapSkipsCellsWhereTheWeightDoesNotMatter) {
+  const std::vector<double> grid = pdflab::weight_grid(21);
+  WeightPredictor p(3, grid, 0.5, WeightFamily{1.0});
+  const Mixture m;
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 1000; ++i) {
+    const float seen[3] = {2.0f, 2.0f, 2.0f};
+    p.add_path(0, seen, {}, 1.0);
+    const double x = m.sample(0.5, rng);
+    const float value = static_cast<float>(2.0 * x / m.pdf(0.5, x));
+    const float rgb[3] = {value, value, value};
+    const MixtureVertex v = m.vertex(x);
+    p.add_path(1, rgb, {&v, 1}, 1.0);
+  }
+  const std::vector<float> map = p.best_weight_map({2, 2, 2, 1, 1, 1, 1, 1, 1}, 0.0);
+  EXPECT_EQ(map[0], -1.0f) << "the weight does not matter here";
+  EXPECT_GE(map[1], 0.0f);
+  EXPECT_EQ(map[2], -1.0f) << "no paths";
+}
+
 TEST(WeightPrediction, WeightThatCannotDrawAPathHasNoEfficiency) {
   const std::vector<double> grid = {0.0, 0.5, 1.0};
   WeightPredictor p(1, grid, 0.5, WeightFamily{1.0});

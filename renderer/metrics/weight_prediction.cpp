@@ -211,15 +211,19 @@ std::vector<float> WeightPredictor::best_weight_map(const std::vector<float>& me
   std::vector<float> map(static_cast<std::size_t>(cells_), -1.0f);
   for (int cell = 0; cell < cells_; ++cell) {
     if (count_[static_cast<std::size_t>(cell)] == 0) continue;
-    double least = std::numeric_limits<double>::infinity();
+    double least = std::numeric_limits<double>::infinity(), most = 0.0;
     for (std::size_t g = 0; g < grid_.size(); ++g) {
       double m = 0.0;
       for (int c = 0; c < 3; ++c) {
         const double mu = static_cast<double>(mean_rgb[static_cast<std::size_t>(cell) * 3 + static_cast<std::size_t>(c)]);
         m += second_moment(cell, g, c) / (mu * mu + epsilon);
       }
+      most = std::max(most, m);
       if (m < least) least = m, map[static_cast<std::size_t>(cell)] = static_cast<float>(grid_[g]);
     }
+    // A moment that does not depend on w' (no light found, or only lights
+    // seen directly, through no diffuse vertex) has no best weight.
+    if (!(most > least * (1.0 + 1e-6))) map[static_cast<std::size_t>(cell)] = -1.0f;
   }
   return map;
 }

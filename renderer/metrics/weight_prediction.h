@@ -143,7 +143,8 @@ class WeightPredictor {
                            double cost_offset = 0.0, const std::vector<float>* mean_square_rgb = nullptr) const;
 
   // Per cell, the grid weight with the least predicted second moment (summed
-  // over channels, relative to mu^2 + eps); -1 for a cell without paths.
+  // over channels, relative to mu^2 + eps); -1 for a cell without paths or
+  // whose moment does not depend on the weight (w does not matter there).
   std::vector<float> best_weight_map(const std::vector<float>& mean_rgb, double epsilon) const;
 
   // The second moment per channel of one cell at grid point g (0 without paths).
