@@ -217,7 +217,7 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
                       {"nee-mis:balance", 128, false},
                       {"mix:cosine=0.5,light-sa=0.5+rr", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5", 128, false},
-                      {"fastest", 128, false},  // today nee-mis+sobol: nee-mis's spp
+                      {"fastest", 128, false},  // today nee-mis+sobol+rr:5: nee-mis's spp
                       {"mix:cosine=0.5,light=0.5+sobol", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256, false}};  // today the book mixture: its spp
   constexpr int kSmall = 24;

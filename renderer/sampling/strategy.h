@@ -27,13 +27,13 @@ std::string_view technique_name(Technique t);
 
 // What `fastest` expands to: pdflab's most efficient unbiased strategy for
 // general scenes, by measurement on the shipped scenes (docs/convergence.md,
-// scripts/fastest_report.sh). Next-event estimation with the Sobol sampler:
-// 0.9-1.05x the book's mixture in the closed boxes with glass or metal, 2.4x
-// to 23x wherever light comes straight from the emitters (the stratified light
-// sample at the first vertices is the lever); the book's box gains more from
-// the mixture continuation (nee-mis+mix:cosine=0.5,light=0.5, 1.25x), which
-// loses 2x in the boxes without glass.
-inline constexpr std::string_view kFastestStrategy = "nee-mis+sobol";
+// scripts/fastest_report.sh). Next-event estimation with the Sobol sampler
+// (the stratified light sample at the first vertices is the lever wherever
+// light comes straight from the emitters) and Russian roulette from the fifth
+// segment (it cuts the long paths of the closed boxes, where nee-mis pays two
+// rays a bounce; from the third it also cut paths that still carry a bright
+// light's direct share, and lost a third on the far and large lights).
+inline constexpr std::string_view kFastestStrategy = "nee-mis+sobol+rr:5";
 
 // Russian roulette's default first depth, and the largest one accepted.
 inline constexpr int kDefaultRouletteDepth = 3;
