@@ -35,7 +35,8 @@ namespace pdflab::qmc {
 inline constexpr int kBits = 32;
 
 template <class U>
-PDFLAB_QMC constexpr U reverse_bits(U v) {
+PDFLAB_QMC constexpr U reverse_bits(const U& bits) {
+  U v = bits;
   v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
   v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
   v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
@@ -66,7 +67,7 @@ inline constexpr Directions kDirections = make_directions();
 
 // Sobol dimension `dim` (0, 1 or 2) of point `index`, unscrambled, as 32 bits.
 template <class U>
-PDFLAB_QMC U sobol(U index, int dim) {
+PDFLAB_QMC U sobol(const U& index, int dim) {
   if (dim == 0) return reverse_bits(index);
   const std::uint32_t* column = kDirections.column[dim - 1];
   U result = index ^ index;  // zero, of U's type
@@ -81,7 +82,8 @@ PDFLAB_QMC U sobol(U index, int dim) {
 
 // A 32-bit integer hash (a two-multiply xorshift finaliser), for seeds.
 template <class U>
-PDFLAB_QMC U hash(U x) {
+PDFLAB_QMC U hash(const U& value) {
+  U x = value;
   x ^= x >> 16;
   x *= 0x21f0aaadu;
   x ^= x >> 15;
@@ -95,8 +97,8 @@ PDFLAB_QMC U hash(U x) {
 // that is a nested uniform (Owen) scramble: a bit of the value is flipped by a
 // hash of the bits above it.
 template <class U>
-PDFLAB_QMC U laine_karras(U v, U seed) {
-  v += seed;
+PDFLAB_QMC U laine_karras(const U& value, const U& seed) {
+  U v = value + seed;
   v ^= v * 0x6c50b47cu;
   v ^= v * 0xb82f1e52u;
   v ^= v * 0xc7afe638u;
@@ -106,7 +108,7 @@ PDFLAB_QMC U laine_karras(U v, U seed) {
 
 // Owen scramble of v by `seed` (a bijection of [0, 2^32)).
 template <class U>
-PDFLAB_QMC U owen_scramble(U v, U seed) {
+PDFLAB_QMC U owen_scramble(const U& v, const U& seed) {
   return reverse_bits(laine_karras(reverse_bits(v), seed));
 }
 
@@ -128,7 +130,7 @@ constexpr ReversedDirections make_reversed_directions() {
 inline constexpr ReversedDirections kReversedDirections = make_reversed_directions();
 
 template <class U>
-PDFLAB_QMC U sobol_reversed(U index, int dim) {
+PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
   if (dim == 0) return index;  // van der Corput is the reversal itself
   const std::uint32_t* column = kReversedDirections.column[dim - 1];
   U result = index ^ index;  // zero, of U's type
@@ -145,7 +147,7 @@ inline constexpr int kDepths = 2;
 // The seed of draw group `group` at the vertex reached by segment `depth` of a
 // sample whose pixel seed is `pixel_seed`.
 template <class U>
-PDFLAB_QMC U group_seed(U pixel_seed, U depth, Group group) {
+PDFLAB_QMC U group_seed(const U& pixel_seed, const U& depth, Group group) {
   return hash(pixel_seed ^ hash(depth * 4u + (static_cast<std::uint32_t>(group) + 1u)));
 }
 
@@ -162,8 +164,8 @@ struct Point {
   U dim[3];
 };
 template <class U>
-PDFLAB_QMC Point<U> point(U index, U seed, int dims = 3) {
-  seed = hash(seed ^ (index >> kIndexBits));
+PDFLAB_QMC Point<U> point(const U& index, const U& block_seed, int dims = 3) {
+  const U seed = hash(block_seed ^ (index >> kIndexBits));
   // The shuffled index, its low kIndexBits bits only (the others are the
   // seed's, the same for every sample of the block).
   const U shuffled = owen_scramble(index, seed) & ((1u << kIndexBits) - 1u);
@@ -176,7 +178,7 @@ PDFLAB_QMC Point<U> point(U index, U seed, int dims = 3) {
 // The point of draw group `group` at the vertex reached by segment `depth`,
 // for sample `index` of the pixel whose seed is `pixel_seed` (Rng::qmc_*).
 template <class U>
-PDFLAB_QMC Point<U> group_point(U index, U pixel_seed, U depth, Group group, int dims) {
+PDFLAB_QMC Point<U> group_point(const U& index, const U& pixel_seed, const U& depth, Group group, int dims) {
   return point(index, group_seed(pixel_seed, depth, group), dims);
 }
 
