@@ -229,8 +229,6 @@ TEST(WeightPrediction, MergeEqualsOneAccumulation) {
   EXPECT_THROW(first.merge(other), pdflab::InputError);
 }
 
-// A direction only B can draw has density 0 at w' = 1: the path could not
-// occur there, the second moment is infinite and that weight is never "best".
 // A cell whose paths pass no diffuse vertex (a light seen directly) has the
 // same moment at every weight: no best weight, as a cell without paths.
 TEST(WeightPrediction, BestWeightMapSkipsCellsWhereTheWeightDoesNotMatter) {
@@ -253,6 +251,8 @@ TEST(WeightPrediction, BestWeightMapSkipsCellsWhereTheWeightDoesNotMatter) {
   EXPECT_EQ(map[2], -1.0f) << "no paths";
 }
 
+// A direction only B can draw has density 0 at w' = 1: the path could not
+// occur there, the second moment is infinite and that weight is never "best".
 TEST(WeightPrediction, WeightThatCannotDrawAPathHasNoEfficiency) {
   const std::vector<double> grid = {0.0, 0.5, 1.0};
   WeightPredictor p(1, grid, 0.5, WeightFamily{1.0});
@@ -429,6 +429,26 @@ TEST(CostFit, AutoWeightSettlesWhenTwoPredictionsAgree) {
   moved.add_pass(far);
   EXPECT_LT(moved.weight(), 0.5);
   EXPECT_FALSE(moved.settled());
+
+  // A pass that chooses nothing (no paths; or a pooled prediction with no
+  // finite best) keeps the weight without agreeing with it.
+  pdflab::WeightPrediction empty = peaked(0.5);
+  empty.paths = 0;
+  pdflab::AutoWeight guessed(0.5, 21, 0.0);
+  guessed.add_pass(empty);
+  guessed.add_pass(empty);
+  EXPECT_DOUBLE_EQ(guessed.weight(), 0.5);
+  EXPECT_FALSE(guessed.settled()) << "two passes without paths froze the first guess";
+  pdflab::AutoWeight once(0.5, 21, 0.0);
+  once.add_pass(peaked(0.7));
+  once.add_pass(empty);
+  EXPECT_DOUBLE_EQ(once.weight(), 0.7);
+  EXPECT_FALSE(once.settled()) << "one choice and a pass without paths are not two choices";
+  pdflab::WeightPrediction unbounded = peaked(0.7);
+  unbounded.relative_variance.assign(unbounded.weight.size(), std::numeric_limits<double>::infinity());
+  once.add_pass(unbounded);
+  EXPECT_DOUBLE_EQ(once.weight(), 0.7);
+  EXPECT_FALSE(once.settled()) << "a pooled prediction with no best chose nothing";
 }
 
 TEST(WeightPrediction, ForecastSeedIsAnotherSeed) {

@@ -218,9 +218,7 @@ std::uint64_t forecast_seed(std::uint64_t render_seed) {
 
 CostModel AutoWeight::pricing_model(const WeightPrediction& p, double seconds_per_sample) const {
   if (model_.per_ray > 0.0 || !(seconds_per_sample > 0.0)) return model_;
-  CostFit one;
-  one.add(p.sampling_cost, seconds_per_sample);
-  return one.fit(prior_offset_, kFitSpread);
+  return anchored_cost_model(p.sampling_cost, seconds_per_sample, prior_offset_);
 }
 
 WeightPrediction AutoWeight::priced(WeightPrediction p, double seconds_per_sample) const {
@@ -239,12 +237,14 @@ std::uint32_t AutoWeight::replay_samples(std::uint32_t pass_spp) {
 }
 
 AutoWeight::AutoWeight(double first, int grid_points, double prior_offset)
-    : grid_(weight_grid(grid_points)), prior_offset_(prior_offset), history_{defended_weight(first)} {}
+    : grid_(weight_grid(grid_points)), prior_offset_(prior_offset), history_{defended_weight(first)}, chosen_{false} {}
 
 bool AutoWeight::settled() const {
-  // history_: the first guess, then one weight per prediction.
+  // history_: the first guess, then one weight per prediction; chosen_: which
+  // of those a prediction chose (a pass without paths, or whose pooled
+  // prediction has no best, keeps the weight without choosing it).
   const std::size_t n = history_.size();
-  return n >= 3 && history_[n - 1] == history_[n - 2];
+  return n >= 3 && chosen_[n - 1] && chosen_[n - 2] && history_[n - 1] == history_[n - 2];
 }
 
 void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per_sample) {
@@ -258,7 +258,9 @@ void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per
   // fitted so far or, without timing, by rays alone.
   const WeightPrediction pooled =
       pooled_prediction(passes_, model_.per_ray > 0.0 ? model_ : CostModel{0.0, 1.0, false});
+  const bool chose = pooled.best >= 0 && prediction.paths > 0;
   history_.push_back(pooled.best >= 0 ? defended_weight(pooled.best_weight()) : history_.back());
+  chosen_.push_back(chose);
 }
 
 }  // namespace pdflab

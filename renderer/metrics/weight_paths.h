@@ -120,8 +120,8 @@ std::uint64_t forecast_seed(std::uint64_t render_seed);
 // costs several per cent of a short run, less of a long one), and the next
 // weight is the best of the passes' predictions so far, pooled (each counted
 // by its number of paths; see add_pass). Once two predictions in a row choose
-// the same weight (settled()), the later passes keep it and trace no more
-// forecast paths: the forecast runs on the one-path tracer, several times
+// the same weight (settled()), `sweep --auto`'s later passes keep it and trace
+// no more forecast paths (the viewer keeps predicting for its live curve): the forecast runs on the one-path tracer, several times
 // dearer a sample than the packet tracer, and on the shipped scenes a settled
 // weight moved by at most one grid step afterwards (docs/measuring.md).
 //
@@ -145,7 +145,8 @@ class AutoWeight {
   explicit AutoWeight(double first = 0.5, int grid_points = 21, double prior_offset = kPriorOffset);
   double weight() const { return history_.back(); }  // for the next pass
   // Whether the latest prediction kept the weight the one before it chose (the
-  // first pass's weight is a guess, not a choice): then predicting stops.
+  // first pass's weight is a guess, not a choice, and so is a weight kept by a
+  // pass without paths or without a best): then predicting may stop.
   bool settled() const;
   // A finished pass's prediction (on grid()) and its measured seconds per
   // sample (one sample in every cell; 0: unknown, rays alone price it): the
@@ -161,7 +162,7 @@ class AutoWeight {
   // The model priced() uses for a prediction with this time per sample.
   CostModel pricing_model(const WeightPrediction& prediction, double seconds_per_sample) const;
   const std::vector<double>& grid() const { return grid_; }
-  const std::vector<double>& history() const { return history_; }  // every pass's weight, and the next
+  const std::vector<double>& history() const { return history_; }  // the first guess, then one weight per add_pass
   const CostModel& cost_model() const { return model_; }           // the latest fit (zero before a timed pass)
 
  private:
@@ -171,6 +172,7 @@ class AutoWeight {
   CostFit fit_;
   CostModel model_;
   std::vector<double> history_;
+  std::vector<bool> chosen_;  // per history_ entry: chosen by a prediction
 };
 
 }  // namespace pdflab
