@@ -238,9 +238,7 @@ int run_bench(const BenchOptions& o) {
     const double offset = std::clamp(cost_fit.fit(AutoWeight::kPriorOffset).offset(), 0.0, 10.0);
     // Re-priced, not predicted again: the pilot's time per sample split with
     // that fixed cost.
-    CostFit anchored;
-    anchored.add(p.sampling_cost, seconds_per_sample);
-    const CostModel model = anchored.fit(offset);
+    const CostModel model = anchored_cost_model(p.sampling_cost, seconds_per_sample, offset);
     if (model.per_ray > 0.0) apply_cost_model(p, model);
     predicted_best = p.best_weight();
     for (std::size_t i = 0; i < results.size(); ++i)

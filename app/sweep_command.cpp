@@ -508,14 +508,16 @@ int run_sweep(const SweepOptions& o) {
     return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
   };
   std::vector<double> row_rays(rows.size(), std::nan("")), row_seconds_per_sample(rows.size(), std::nan(""));
+  // The rays at each weight pooled over the pilot's seeds as the curve is
+  // (each seed counted by its paths; the pricing does not change them).
+  const std::vector<double> pooled_rays =
+      predictions.empty() ? std::vector<double>{} : pooled_prediction(predictions, CostModel{0.0, 1.0, false}).cost;
   CostFit cost_fit;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     row_seconds_per_sample[i] = interval(per_sample[i]).mean;
-    if (predictions.empty() || per_sample[i].empty()) continue;
-    double rays = 0.0;
-    for (const WeightPrediction& p : predictions) rays += p.cost[grid_index(rows[i].weight)] / static_cast<double>(predictions.size());
-    row_rays[i] = rays;
-    cost_fit.add(rays, row_seconds_per_sample[i]);
+    if (pooled_rays.empty() || per_sample[i].empty()) continue;
+    row_rays[i] = pooled_rays[grid_index(rows[i].weight)];
+    cost_fit.add(row_rays[i], row_seconds_per_sample[i]);
   }
   const CostModel cost_model = cost_fit.fit(AutoWeight::kPriorOffset);
   if (cost_model.per_ray > 0.0)

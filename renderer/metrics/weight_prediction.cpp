@@ -170,6 +170,12 @@ CostModel CostFit::fit(double prior_offset, double min_spread) const {
   return m;
 }
 
+CostModel anchored_cost_model(double rays_per_sample, double seconds_per_sample, double fixed_rays) {
+  CostFit one;
+  one.add(rays_per_sample, seconds_per_sample);
+  return one.fit(fixed_rays);
+}
+
 void apply_cost_model(WeightPrediction& p, const CostModel& model) {
   p.best = -1;
   double best = -1.0;

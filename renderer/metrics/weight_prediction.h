@@ -103,6 +103,11 @@ class CostFit {
   std::vector<double> x_, y_;
 };
 
+// The model one timed point gives: `seconds_per_sample` at `rays_per_sample`
+// rays, split with `fixed_rays` rays of fixed cost per sample (CostFit's
+// fall-back). What prices a prediction at its own pilot's time.
+CostModel anchored_cost_model(double rays_per_sample, double seconds_per_sample, double fixed_rays);
+
 // The prediction's efficiency under `model`: 1 / (relative variance *
 // model.seconds(cost)) at each weight, and its best. The model's units are the
 // efficiency's: seconds per sample of every cell gives a render's efficiency.
