@@ -121,9 +121,10 @@ std::uint64_t forecast_seed(std::uint64_t render_seed);
 // weight is the best of the passes' predictions so far, pooled (each counted
 // by its number of paths; see add_pass). Once two predictions in a row choose
 // the same weight (settled()), `sweep --auto`'s later passes keep it and trace
-// no more forecast paths (the viewer keeps predicting for its live curve): the forecast runs on the one-path tracer, several times
-// dearer a sample than the packet tracer, and on the shipped scenes a settled
-// weight moved by at most one grid step afterwards (docs/measuring.md).
+// no more forecast paths (the viewer keeps predicting for its live curve):
+// the forecast runs on the one-path tracer, several times dearer a sample
+// than the packet tracer, and on the shipped scenes a settled weight moved by
+// at most one grid step afterwards (docs/measuring.md).
 //
 // The time a weight costs comes from a CostModel (weight_prediction.h) fitted
 // to the passes' own timing: each pass gives its seconds per sample and its
