@@ -146,6 +146,7 @@ bool WeightLab::update(const Input& in) {
   TechniquePair pair;
   pair.a = std::string(technique_name(static_cast<Technique>(in.a)));
   pair.b = std::string(technique_name(static_cast<Technique>(in.b)));
+  pair.roulette_depth = in.strategy.roulette_depth;  // the paths' own (the prediction weighs its checks)
   maps_.a = pair.a;
   maps_.b = pair.b;
   const double w = pair.weight_of(in.strategy);

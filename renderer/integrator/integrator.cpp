@@ -215,6 +215,11 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
     if (m.type == MaterialType::Lambertian) {
       // Sampled, and its pdf evaluated, from the point the ray leaves from.
       const Vec3 origin = diffuse_origin(hit, normal);
+      float roulette = 0.0f;  // recorded: q before the cut, where a check is taken
+      if (record && plan.roulette_depth > 0 && depth + 1 >= plan.roulette_depth) {
+        roulette = leaf::roulette_largest(throughput, m.albedo);
+        if (!std::isfinite(roulette)) roulette = 0.0f;  // survives at every weight (and is dropped)
+      }
       if (!roulette_survives(plan, depth, throughput, m.albedo, rng)) break;
       const DirectionSample ds = plan.sample(origin, normal, rng, nullptr, depth);
       if (ds.none) break;  // a light seen edge-on: a valid zero estimate
@@ -228,7 +233,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       }
       // Drawn with the mixture's density, whatever becomes of it: a direction
       // below the surface ends the path, with a probability that depends on the weights.
-      if (record) record->vertices.push_back({origin, normal, ds.direction});  // where its pdfs were evaluated
+      if (record) record->vertices.push_back({origin, normal, ds.direction, roulette, record->segments});  // where its pdfs were evaluated
       const float cosine = dot(ds.direction, normal);
       if (cosine <= 0.0f) break;  // below the surface: the BRDF is zero, a valid zero estimate
       throughput *= m.albedo * leaf::lambert_weight(cosine, ds.pdf);

@@ -48,10 +48,15 @@ inline std::uint8_t drop_reason_bits(const DropCounts& before, const DropCounts&
 
 // What the mixture-weight predictor needs of a path (renderer/metrics/weight_paths.h):
 // each diffuse vertex's point, normal (facing the arriving ray) and the direction
-// the mixture drew there, and how many rays the path traced.
+// the mixture drew there, and how many rays the path traced. With Russian
+// roulette, also each survived check's largest throughput * albedo (the
+// survival probability before it is cut to 1, which depends on the weights
+// the path was drawn with) and where on the path each vertex lies.
 struct PathRecord {
   struct Vertex {
     Vec3 point, normal, direction;
+    float roulette = 0.0f;  // leaf::roulette_largest at the check before the direction; 0: no check
+    int segments = 0;       // segments traced up to this vertex, the one reaching it included
   };
   std::vector<Vertex> vertices;
   int segments = 0;

@@ -126,7 +126,7 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
   const SamplingPlan plan_rest = has_rest ? SamplingPlan::make(family.rest, scene) : SamplingPlan{};
   const float rest_weight = static_cast<float>(1.0 - family.share);
   const int width = scene.camera.width, height = scene.camera.height;
-  const WeightFamily weights{family.share};
+  const WeightFamily weights{family.share, plan.roulette_depth > 0};
   if (o.technique_share) o.technique_share->resize(static_cast<std::size_t>(width * height) * kShareKinds, 0.0);
 
   int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -154,6 +154,8 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
             m.a = plan_a.pdf(v.point, v.normal, v.direction);
             m.b = plan_b.pdf(v.point, v.normal, v.direction);
             m.rest = has_rest ? rest_weight * plan_rest.pdf(v.point, v.normal, v.direction) : 0.0f;
+            m.roulette = v.roulette;
+            m.segments = v.segments;
             vertices.push_back(m);
           }
           if (o.film) o.film->add(static_cast<std::size_t>(y * width + x), radiance);  // pixels of disjoint rows

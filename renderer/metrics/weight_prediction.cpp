@@ -28,6 +28,7 @@ WeightPredictor::WeightPredictor(int cells, std::vector<double> grid, double sam
   cost_sum_.assign(grid_.size(), 0.0);
   offset_sum_.assign(grid_.size(), 0.0);
   ratio_.assign(grid_.size(), 1.0);
+  path_cost_.assign(grid_.size(), 0.0);
 }
 
 void WeightPredictor::clear() {
@@ -45,11 +46,24 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
   // R(w') = prod_k p_w(k) / p_w'(k). A vertex whose direction has density 0 at
   // w' makes R infinite: at w' the path could not have been drawn.
   std::fill(ratio_.begin(), ratio_.end(), 1.0);
-  for (const MixtureVertex& v : vertices) {
+  if (family_.roulette) {
+    // The segments before the first diffuse vertex are traced at every weight.
+    std::fill(path_cost_.begin(), path_cost_.end(), vertices.empty() ? cost : static_cast<double>(vertices[0].segments));
+  }
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const MixtureVertex& v = vertices[k];
     const double here = family_.pdf(v, w_);
+    const double m = static_cast<double>(v.roulette);
+    const double q_here = std::min(1.0, m);
+    // Segments from this vertex's continuation up to the next vertex (or the
+    // path's end): traced because of everything up to and including here.
+    const double after = (k + 1 < vertices.size() ? static_cast<double>(vertices[k + 1].segments) : cost) -
+                         static_cast<double>(v.segments);
     for (std::size_t g = 0; g < grid_size; ++g) {
+      if (family_.roulette && m > 0.0) ratio_[g] *= q_here / std::min(1.0, m * ratio_[g]);  // survived the check
       const double there = family_.pdf(v, grid_[g]);
       ratio_[g] *= there > 0.0 ? here / there : std::numeric_limits<double>::infinity();
+      if (family_.roulette) path_cost_[g] += after / ratio_[g];
     }
   }
   double* moment = &moment_[(static_cast<std::size_t>(cell) * grid_size) * 3];
@@ -58,6 +72,12 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
     for (int c = 0; c < 3; ++c) {
       const double f = static_cast<double>(rgb[c]);
       if (f != 0.0) moment[g * 3 + static_cast<std::size_t>(c)] += f * f * r;  // 0 * inf stays out
+    }
+    if (family_.roulette) {
+      // Summed by segment, so a plain mean: no ratio whose mean is 1 to divide by.
+      cost_sum_[g] += path_cost_[g];
+      offset_sum_[g] += 1.0;
+      continue;
     }
     const double inverse = 1.0 / r;  // 0 for an infinite ratio
     cost_sum_[g] += cost * inverse;
@@ -69,7 +89,8 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
 }
 
 void WeightPredictor::merge(const WeightPredictor& o) {
-  if (o.cells_ != cells_ || o.grid_ != grid_ || o.w_ != w_ || o.family_.share != family_.share)
+  if (o.cells_ != cells_ || o.grid_ != grid_ || o.w_ != w_ || o.family_.share != family_.share ||
+      o.family_.roulette != family_.roulette)
     throw InputError("weight predictors with different cells, grids or weights cannot be merged");
   for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
   for (std::size_t i = 0; i < moment_.size(); ++i) moment_[i] += o.moment_[i];

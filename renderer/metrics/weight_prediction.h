@@ -10,15 +10,26 @@
 //
 //     p_w = s (w a + (1 - w) b) + r.
 //
-// A path's pdf is the product of p_w over its diffuse vertices (the tracer has
-// no Russian roulette; specular bounces do not depend on w). For a path drawn
-// at w with estimate F_w = f / prod p_w, the same path at w' would have
-// estimated F_w' = F_w R with R = prod_k p_w(k) / p_w'(k), and
+// A path's pdf is the product of p_w over its diffuse vertices (specular
+// bounces do not depend on w). For a path drawn at w with estimate F_w = f /
+// prod p_w, the same path at w' would have estimated F_w' = F_w R with
+// R = prod_k p_w(k) / p_w'(k), and
 //
 //     M(w') = E_w'[F_w'^2] = E_w[F_w'^2 prod_k p_w'(k) / p_w(k)] = E_w[F_w^2 R]
 //     C(w') = E_w'[cost]   = E_w[cost / R]
 //
-// are both estimated without bias from the paths at w. With a pixel's mean mu
+// are both estimated without bias from the paths at w.
+//
+// With Russian roulette the path's pdf also holds each check's survival
+// probability q = min(1, m), m the largest component of throughput * albedo
+// there. The throughput before vertex k at w' is the one at w times R_<k, the
+// ratio of everything before k, so q_w'(k) = min(1, m_k R_<k), and R gains a
+// factor q_w(k) / q_w'(k) at each check the path survived (a path that did not
+// survive carries no estimate, so M is as above). The cost is then summed
+// segment by segment, C(w') = E_w[sum over segments of 1 / R of what decided
+// that the segment is traced]: a path that at w' could end at a check where at
+// w it always goes on (q_w = 1 > q_w') is, for its cost, the start of a path
+// that went on, which the whole path's ratio would not count. With a pixel's mean mu
 // (which does not depend on w), its variance at w' is M(w') - mu^2, and the
 // image-wide relative variance is the mean over pixels and channels of
 // variance / (mu^2 + epsilon), the relMSE of one sample per pixel. At equal
@@ -43,11 +54,17 @@ struct MixtureVertex {
   float a = 0.0f;     // technique A's pdf
   float b = 0.0f;     // technique B's pdf
   float rest = 0.0f;  // sum of w_i p_i over the techniques that are not varied
+  // With Russian roulette (WeightFamily::roulette): the largest component of
+  // throughput * albedo at the check taken before this direction was drawn
+  // (0: no check here), and the segments traced up to this vertex.
+  float roulette = 0.0f;
+  int segments = 0;
 };
 
 // The family of mixtures: A's share w of the pair whose total weight is `share`.
 struct WeightFamily {
-  double share = 1.0;  // wA + wB of the normalised weights, in (0, 1]
+  double share = 1.0;     // wA + wB of the normalised weights, in (0, 1]
+  bool roulette = false;  // the paths had Russian roulette (Strategy::roulette_depth > 0)
   double pdf(const MixtureVertex& v, double w) const {
     return share * (w * static_cast<double>(v.a) + (1.0 - w) * static_cast<double>(v.b)) + static_cast<double>(v.rest);
   }
@@ -170,6 +187,7 @@ class WeightPredictor {
   std::vector<double> offset_sum_;     // per grid point: sum of 1 / R (should approach the path count)
   double plain_cost_sum_ = 0.0;        // sum of cost, at the sampling weight
   std::vector<double> ratio_;          // scratch: R per grid point for the path being added
+  std::vector<double> path_cost_;      // scratch: with roulette, the path's cost at each grid point
   std::uint64_t paths_ = 0;
 };
 
