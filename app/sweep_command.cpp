@@ -511,7 +511,7 @@ int run_sweep(const SweepOptions& o) {
   // The rays at each weight pooled over the pilot's seeds as the curve is
   // (each seed counted by its paths; the pricing does not change them).
   const std::vector<double> pooled_rays =
-      predictions.empty() ? std::vector<double>{} : pooled_prediction(predictions, CostModel{0.0, 1.0, false}).cost;
+      predictions.empty() ? std::vector<double>{} : pooled_prediction(predictions, kRaysAlone).cost;
   CostFit cost_fit;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     row_seconds_per_sample[i] = interval(per_sample[i]).mean;

@@ -89,8 +89,8 @@ void WeightLab::reset(std::uint64_t generation) {
 void WeightLab::take(Result r, const AutoWeight& pricing) {
   predictor_ = std::move(r.predictor);
   share_ = std::move(r.share);
-  const CostModel model = pricing.pricing_model(r.prediction, r.seconds_per_sample);  // the one priced() uses
-  const WeightPrediction p = pricing.priced(r.prediction, r.seconds_per_sample);
+  CostModel model;
+  const WeightPrediction p = pricing.priced(r.prediction, r.seconds_per_sample, &model);
   curve_.fixed_cost_rays = model.per_ray > 0.0 ? model.offset() : -1.0;
   curve_.cost_fitted = model.fitted;
   curve_.active = p.best >= 0;

@@ -223,9 +223,10 @@ CostModel AutoWeight::pricing_model(const WeightPrediction& p, double seconds_pe
   return anchored_cost_model(p.sampling_cost, seconds_per_sample, prior_offset_);
 }
 
-WeightPrediction AutoWeight::priced(WeightPrediction p, double seconds_per_sample) const {
+WeightPrediction AutoWeight::priced(WeightPrediction p, double seconds_per_sample, CostModel* used) const {
   const CostModel model = pricing_model(p, seconds_per_sample);
   if (model.per_ray > 0.0) apply_cost_model(p, model);
+  if (used) *used = model;
   return p;
 }
 
@@ -259,7 +260,7 @@ void AutoWeight::add_pass(const WeightPrediction& prediction, double seconds_per
   // The passes' predictions pooled (pooled_prediction), priced by the model
   // fitted so far or, without timing, by rays alone.
   const WeightPrediction pooled =
-      pooled_prediction(passes_, model_.per_ray > 0.0 ? model_ : CostModel{0.0, 1.0, false});
+      pooled_prediction(passes_, model_.per_ray > 0.0 ? model_ : kRaysAlone);
   const bool chose = pooled.best >= 0 && prediction.paths > 0;
   history_.push_back(pooled.best >= 0 ? defended_weight(pooled.best_weight()) : history_.back());
   chosen_.push_back(chose);

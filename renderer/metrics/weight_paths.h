@@ -158,8 +158,9 @@ class AutoWeight {
   // `prediction` priced as add_pass prices the passes: by the cost model
   // fitted to the passes so far or, before a fit, by its own seconds per
   // sample split with the prior fixed cost (the same model add_pass makes of
-  // a first pass). What the viewer's curve shows.
-  WeightPrediction priced(WeightPrediction prediction, double seconds_per_sample) const;
+  // a first pass). What the viewer's curve shows; `used`, if given, receives
+  // that model.
+  WeightPrediction priced(WeightPrediction prediction, double seconds_per_sample, CostModel* used = nullptr) const;
   // The model priced() uses for a prediction with this time per sample.
   CostModel pricing_model(const WeightPrediction& prediction, double seconds_per_sample) const;
   const std::vector<double>& grid() const { return grid_; }

@@ -102,6 +102,10 @@ struct CostModel {
   double offset() const { return per_ray > 0.0 ? per_sample / per_ray : 0.0; }
 };
 
+// A cost of rays alone (no fixed cost a sample): efficiency in units of
+// 1 / (relative variance * rays), for comparing weights without timing.
+inline constexpr CostModel kRaysAlone{0.0, 1.0, false};
+
 // Least-squares fit of a CostModel to (rays per sample, seconds per sample)
 // points: runs at different weights trace paths of different lengths, and
 // their times tell the two costs apart.
