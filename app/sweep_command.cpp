@@ -309,6 +309,8 @@ struct Row {
   Interval predicted;  // efficiency predicted from the pilot weight's runs
   Interval predicted_relmse_spp;  // the relative variance the pilot's paths predict
   double predicted_rays_only = 0.0;  // the same with a cost of rays alone (no fixed cost per sample)
+  double predicted_share = std::nan("");  // the largest pilot path's share of the predicted second moment
+  double largest_share = std::nan("");    // the largest seed's share of the row's summed relMSE x spp
 };
 
 // "The best fixed weight's efficiency" measured fairly. The best row's mean is
@@ -589,6 +591,12 @@ int run_sweep(const SweepOptions& o) {
     r.predicted.high = r.predicted_relmse_spp.lo() > 0.0 ? inverse(r.predicted_relmse_spp.lo() * seconds_here)
                                                           : std::numeric_limits<double>::infinity();
     r.predicted_rays_only = rays_only.efficiency[g];
+    if (!pooled.largest_share.empty()) r.predicted_share = pooled.largest_share[g];
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    double sum = 0.0, top = 0.0;
+    for (double v : relspp[i]) sum += v, top = std::max(top, v);
+    if (relspp[i].size() > 1 && sum > 0.0) rows[i].largest_share = top / sum;
   }
   Interval predicted_optimum = interval(predicted_best);
   predicted_optimum.mean = predicted_top >= 0 ? grid[static_cast<std::size_t>(predicted_top)] : std::nan("");
@@ -604,8 +612,9 @@ int run_sweep(const SweepOptions& o) {
     void take(double v, double w) {
       if (v > value) value = v, at = w;
     }
-  } gap_all, gap_high;
+  } gap_all, gap_high, gap_light;
   int gap_inside = 0, gap_rows = 0;
+  std::string heavy;  // the rows whose prediction one path dominates
   for (const Row& r : rows) {
     if (!r.unbiased || r.weight < 0.1 - 1e-9 || r.weight > 0.9 + 1e-9 || !(fair.fitted > 0.0) ||
         !(predicted_peak > 0.0) || !std::isfinite(r.predicted.mean) || !(r.efficiency.mean > 0.0))
@@ -616,13 +625,20 @@ int run_sweep(const SweepOptions& o) {
     if (predicted * fair.fitted >= r.efficiency.lo() && predicted * fair.fitted <= r.efficiency.hi()) ++gap_inside;
     gap_all.take(gap, r.weight);
     if (measured >= 0.3) gap_high.take(gap, r.weight);
+    if (r.predicted_share <= kDominantShare) gap_light.take(gap, r.weight);
   }
+  for (const Row& r : rows)
+    if (r.predicted_share > kDominantShare) {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "%s%.3g (%.0f%%)", heavy.empty() ? "" : ", ", r.weight, 100.0 * r.predicted_share);
+      heavy += buf;
+    }
   std::string csv =
       "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
       "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
       "predicted_efficiency_lo,predicted_efficiency_hi,predicted_relative_efficiency,best,in_best_interval,rays_per_sample,seconds_per_sample,"
       "model_seconds_per_sample,predicted_efficiency_rays_only,relmse_per_sample,relmse_per_sample_lo,relmse_per_sample_hi,"
-      "predicted_relmse_per_sample\n";
+      "predicted_relmse_per_sample,predicted_largest_share,relmse_largest_share\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const int idx = static_cast<int>(i);
@@ -640,7 +656,8 @@ int run_sweep(const SweepOptions& o) {
            num(row_seconds_per_sample[i]) + "," +
            num(std::isfinite(row_rays[i]) ? cost_model.seconds(row_rays[i]) : std::nan("")) + "," +
            num(r.predicted_rays_only) + "," + num(r.relmse_spp.mean) + "," + num(r.relmse_spp.lo()) + "," +
-           num(r.relmse_spp.hi()) + "," + num(r.predicted_relmse_spp.mean) + "\n";
+           num(r.relmse_spp.hi()) + "," + num(r.predicted_relmse_spp.mean) + "," + num(r.predicted_share) + "," +
+           num(r.largest_share) + "\n";
   }
 
   if (o.auto_weight) {
@@ -652,7 +669,7 @@ int run_sweep(const SweepOptions& o) {
            num(auto_efficiency.hi()) + "," +
            num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0,,,,," +
            num(auto_relspp_interval.mean) + "," + num(auto_relspp_interval.lo()) + "," + num(auto_relspp_interval.hi()) +
-           ",\n";
+           ",,,\n";
   }
   std::string plot;
   if (!o.plot.empty()) {
@@ -689,10 +706,27 @@ int run_sweep(const SweepOptions& o) {
                     predicted_optimum.mean);
       predicted.label = buf;
       predicted.dashed = true;
-      for (std::size_t g = 0; g < grid.size(); ++g)
-        if (grid[g] >= weights.front() && grid[g] <= weights.back() && predicted_curve[g] > 0.0)
-          predicted.x.push_back(grid[g]), predicted.y.push_back(predicted_curve[g]);
+      // The weights whose prediction one path dominates drawn apart: there it
+      // is likely too high (the sweep's stdout says why).
+      PlotSeries tail;
+      char tail_label[96];
+      std::snprintf(tail_label, sizeof tail_label, "predicted, one path > %.0f%% of the moment: likely too high",
+                    100.0 * kDominantShare);
+      tail.label = tail_label;
+      tail.dashed = true;
+      for (std::size_t g = 0; g < grid.size(); ++g) {
+        if (!(grid[g] >= weights.front() && grid[g] <= weights.back() && predicted_curve[g] > 0.0)) continue;
+        const auto dominated = [&](std::size_t i) {
+          return i < pooled.largest_share.size() && pooled.largest_share[i] > kDominantShare;
+        };
+        const bool heavy_here = dominated(g);
+        // Both series share the boundary points, so the curve stays whole.
+        const bool heavy_next = dominated(g + 1), heavy_prev = g > 0 && dominated(g - 1);
+        if (!heavy_here || !heavy_next || !heavy_prev) predicted.x.push_back(grid[g]), predicted.y.push_back(predicted_curve[g]);
+        if (heavy_here || heavy_next || heavy_prev) tail.x.push_back(grid[g]), tail.y.push_back(predicted_curve[g]);
+      }
       series.push_back(predicted);
+      if (!tail.x.empty()) series.push_back(tail);
     }
     plot = linear_svg(series, po);
   }
@@ -755,6 +789,14 @@ int run_sweep(const SweepOptions& o) {
                 "%.0f%% (at %.3g) where measured is at least 0.3 of its peak; inside the measured 95%% interval at %d of %d\n",
                 gap_rows, 100.0 * gap_all.value, gap_all.at, 100.0 * std::max(0.0, gap_high.value), gap_high.at,
                 gap_inside, gap_rows);
+  if (gap_light.value >= 0.0)
+    std::printf("  where no single path carries more than %.0f%% of the predicted second moment: largest gap %.0f%% (at %.3g)\n",
+                100.0 * kDominantShare, 100.0 * gap_light.value, gap_light.at);
+  if (!heavy.empty())
+    std::printf("one path carries more than %.0f%% of the predicted second moment at %s: there the moment is infinite or "
+                "carried by paths too rare for the runs to hold, so the predicted and the measured efficiency are "
+                "likely too high\n",
+                100.0 * kDominantShare, heavy.c_str());
   std::printf("load average (1 min): %.2f at the start, %.2f at the end; runs priced by %s\n", load_at_start,
               load_average(), o.cpu_time ? "their CPU time (--cpu-time)" : "the wall clock");
   return 0;

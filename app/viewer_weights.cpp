@@ -97,6 +97,8 @@ void WeightLab::take(Result r, const AutoWeight& pricing) {
   curve_.why = curve_.active ? "" : "no path has found light yet";
   curve_.weight.assign(p.weight.begin(), p.weight.end());
   curve_.relative_efficiency.clear();
+  curve_.largest_share.assign(p.largest_share.begin(), p.largest_share.end());
+  curve_.dominant_share = static_cast<float>(kDominantShare);
   const double top = p.best >= 0 ? p.efficiency[static_cast<std::size_t>(p.best)] : 0.0;
   for (double e : p.efficiency) curve_.relative_efficiency.push_back(top > 0.0 ? static_cast<float>(e / top) : 0.0f);
   // The best inside the floor: at w = 0 or 1 a technique may be biased alone

@@ -99,6 +99,42 @@ TEST(WeightPrediction, SecondMomentAtOtherWeightsMatchesQuadrature) {
   }
 }
 
+// The largest path's share of the predicted second moment (the max-to-sum
+// ratio). B's pdf is 3x^2 here and f = 1: at w' = 0 a term is 1 / (p_w(x)
+// 3x^2), P(term > t) ~ t^(-1/2), no finite mean, and one path keeps a large
+// share however many are drawn; at every other weight the terms are bounded
+// and the share falls like 1 / paths. Pooling parts keeps the verdict.
+TEST(WeightPrediction, LargestShareFlagsTheInfiniteMoment) {
+  const std::vector<double> grid = pdflab::weight_grid(11);
+  const double w = 0.5;
+  const auto pdf = [&](double weight, double x) { return weight + (1.0 - weight) * 3.0 * x * x; };
+  std::vector<pdflab::WeightPrediction> parts;
+  for (std::uint64_t seed : {21u, 22u}) {
+    WeightPredictor p(1, grid, w, WeightFamily{1.0});
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < 100000; ++i) {
+      const double x = u(rng) < w ? u(rng) : std::cbrt(u(rng));
+      const float value = static_cast<float>(1.0 / pdf(w, x));
+      const float rgb[3] = {value, value, value};
+      const MixtureVertex v{1.0f, static_cast<float>(3.0 * x * x), 0.0f};
+      p.add_path(0, rgb, {&v, 1}, 1.0);
+    }
+    parts.push_back(p.predict({1.0f, 1.0f, 1.0f}, 0.0, 0.0));
+  }
+  const pdflab::WeightPrediction pooled = pdflab::pooled_prediction(parts, pdflab::kRaysAlone);
+  for (const pdflab::WeightPrediction& p : {parts[0], parts[1], pooled}) {
+    ASSERT_EQ(p.largest_share.size(), grid.size());
+    EXPECT_GT(p.largest_share[0], pdflab::kDominantShare);
+    for (std::size_t g = 1; g < grid.size(); ++g) EXPECT_LT(p.largest_share[g], 1e-3) << grid[g];
+  }
+  // The pooled share is the largest path of both parts over their summed terms.
+  const double largest = std::max(parts[0].largest_share[5] * parts[0].relative_second_moment[5],
+                                  parts[1].largest_share[5] * parts[1].relative_second_moment[5]);
+  EXPECT_NEAR(pooled.largest_share[5],
+              largest / (parts[0].relative_second_moment[5] + parts[1].relative_second_moment[5]), 1e-12);
+}
+
 TEST(WeightPrediction, PredictedOptimumIsTheTrueOne) {
   const Mixture m;
   const double mu = integrate(f);

@@ -50,19 +50,44 @@ void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int
     const ImVec2 p0 = ImGui::GetCursorScreenPos();
     ImGui::PlotLines("##predicted", c.relative_efficiency.data(), static_cast<int>(c.relative_efficiency.size()), 0,
                      nullptr, 0.0f, 1.05f, ImVec2(width, height));
+    const auto heavy = [&](std::size_t i) { return i < c.largest_share.size() && c.largest_share[i] > c.dominant_share; };
     if (ImGui::IsItemHovered()) {
       const float t = std::clamp((ImGui::GetIO().MousePos.x - p0.x) / width, 0.0f, 1.0f);
       const std::size_t i = static_cast<std::size_t>(std::lround(t * static_cast<float>(c.weight.size() - 1)));
-      ImGui::SetTooltip("w = %.2f: %.0f%% of the best", c.weight[i], 100.0f * c.relative_efficiency[i]);
+      if (heavy(i))
+        ImGui::SetTooltip("w = %.2f: %.0f%% of the best, likely too high (one path carries %.0f%% of the moment)",
+                          c.weight[i], 100.0f * c.relative_efficiency[i], 100.0f * c.largest_share[i]);
+      else
+        ImGui::SetTooltip("w = %.2f: %.0f%% of the best", c.weight[i], 100.0f * c.relative_efficiency[i]);
     }
-    // The predicted best (amber) and the weight the paths came from (white).
+    // Grey over the weights whose prediction one path dominates, the predicted
+    // best (amber) and the weight the paths came from (white).
     ImDrawList* dl = ImGui::GetWindowDrawList();
+    bool any_heavy = false;
+    const float step = c.weight.size() > 1 ? width / static_cast<float>(c.weight.size() - 1) : width;
+    for (std::size_t i = 0; i < c.weight.size(); ++i)
+      if (heavy(i)) {
+        any_heavy = true;
+        const float x = p0.x + static_cast<float>(i) * step;
+        dl->AddRectFilled(ImVec2(std::max(p0.x, x - 0.5f * step), p0.y), ImVec2(std::min(p0.x + width, x + 0.5f * step), p0.y + height),
+                          IM_COL32(150, 150, 150, 110));
+      }
     const auto mark = [&](double w, ImU32 colour, float thickness) {
       const float x = p0.x + static_cast<float>(w) * width;
       dl->AddLine(ImVec2(x, p0.y), ImVec2(x, p0.y + height), colour, thickness);
     };
     if (c.sampling >= 0.0) mark(c.sampling, IM_COL32(230, 230, 230, 200), 1.0f);
     if (c.best >= 0.0) mark(c.best, IM_COL32(255, 190, 60, 255), 2.0f);
+    if (any_heavy) {
+      ImGui::TextColored(kDim, "grey: one path dominates, likely too high");
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("There a single path carries more than %.0f%% of the predicted second moment. With a\n"
+                          "finite moment that share falls as paths are added; where it stays large the moment is\n"
+                          "infinite or carried by paths too rare for the samples so far, so the predicted variance\n"
+                          "is too low and the efficiency too high. A render there has the same trouble: its error\n"
+                          "falls slower than 1/N.",
+                          100.0 * static_cast<double>(c.dominant_share));
+    }
     ImGui::TextColored(kAmber, "predicted best w = %.2f", c.best);
     ImGui::SameLine();
     if (ImGui::Button("Use the best weight") && c.best >= 0.0) {

@@ -113,6 +113,8 @@ struct WeightCurveStatus {
   bool active = false;     // a curve is shown (else `why`)
   std::string why;         // why there is no curve yet
   std::vector<float> weight, relative_efficiency;  // the grid; efficiency over its best
+  std::vector<float> largest_share;  // per grid weight, the largest path's share of the predicted moment (NaN: none)
+  float dominant_share = 0.1f;       // above this share the prediction is likely too high (kDominantShare)
   double best = -1.0;      // the predicted best weight (A's share)
   double sampling = -1.0;  // the weight the paths were drawn at
   std::uint64_t paths = 0;

@@ -25,6 +25,7 @@ WeightPredictor::WeightPredictor(int cells, std::vector<double> grid, double sam
     throw InputError("weight prediction needs at least one cell, one grid weight and a share in (0, 1]");
   count_.assign(static_cast<std::size_t>(cells_), 0);
   moment_.assign(static_cast<std::size_t>(cells_) * grid_.size() * 3, 0.0);
+  peak_.assign(moment_.size(), 0.0);
   cost_sum_.assign(grid_.size(), 0.0);
   offset_sum_.assign(grid_.size(), 0.0);
   ratio_.assign(grid_.size(), 1.0);
@@ -34,6 +35,7 @@ WeightPredictor::WeightPredictor(int cells, std::vector<double> grid, double sam
 void WeightPredictor::clear() {
   std::fill(count_.begin(), count_.end(), 0);
   std::fill(moment_.begin(), moment_.end(), 0.0);
+  std::fill(peak_.begin(), peak_.end(), 0.0);
   std::fill(cost_sum_.begin(), cost_sum_.end(), 0.0);
   std::fill(offset_sum_.begin(), offset_sum_.end(), 0.0);
   plain_cost_sum_ = 0.0;
@@ -67,11 +69,15 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
     }
   }
   double* moment = &moment_[(static_cast<std::size_t>(cell) * grid_size) * 3];
+  double* peak = &peak_[(static_cast<std::size_t>(cell) * grid_size) * 3];
   for (std::size_t g = 0; g < grid_size; ++g) {
     const double r = ratio_[g];
     for (int c = 0; c < 3; ++c) {
       const double f = static_cast<double>(rgb[c]);
-      if (f != 0.0) moment[g * 3 + static_cast<std::size_t>(c)] += f * f * r;  // 0 * inf stays out
+      if (f == 0.0) continue;  // 0 * inf stays out
+      const std::size_t i = g * 3 + static_cast<std::size_t>(c);
+      moment[i] += f * f * r;
+      peak[i] = std::max(peak[i], f * f * r);
     }
     if (family_.roulette) {
       // Summed by segment, so a plain mean: no ratio whose mean is 1 to divide by.
@@ -93,7 +99,7 @@ void WeightPredictor::merge(const WeightPredictor& o) {
       o.family_.roulette != family_.roulette)
     throw InputError("weight predictors with different cells, grids or weights cannot be merged");
   for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
-  for (std::size_t i = 0; i < moment_.size(); ++i) moment_[i] += o.moment_[i];
+  for (std::size_t i = 0; i < moment_.size(); ++i) moment_[i] += o.moment_[i], peak_[i] = std::max(peak_[i], o.peak_[i]);
   for (std::size_t g = 0; g < grid_.size(); ++g) cost_sum_[g] += o.cost_sum_[g], offset_sum_[g] += o.offset_sum_[g];
   plain_cost_sum_ += o.plain_cost_sum_;
   paths_ += o.paths_;
@@ -118,6 +124,8 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
   p.relative_variance.assign(grid_size, 0.0);
   p.cost.assign(grid_size, 0.0);
   p.efficiency.assign(grid_size, 0.0);
+  p.relative_second_moment.assign(grid_size, 0.0);
+  std::vector<double> largest(grid_size, 0.0);  // the largest path's part of the sum over cells and channels
   std::size_t terms = 0;
   for (int cell = 0; cell < cells_; ++cell) {
     if (count_[static_cast<std::size_t>(cell)] == 0) continue;
@@ -130,12 +138,23 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
       // Not clipped per cell: with a few paths a cell's moment often falls
       // below mu^2, and clipping each would bias the sum upwards by an amount
       // that depends on w'. The sum over cells is clipped below.
-      for (std::size_t g = 0; g < grid_size; ++g)
-        p.relative_variance[g] += (second_moment(cell, g, c) - mu2) / denominator;
+      const double n = static_cast<double>(count_[static_cast<std::size_t>(cell)]);
+      for (std::size_t g = 0; g < grid_size; ++g) {
+        const double m = second_moment(cell, g, c);
+        p.relative_variance[g] += (m - mu2) / denominator;
+        p.relative_second_moment[g] += m / denominator;
+        largest[g] = std::max(largest[g], peak_[(static_cast<std::size_t>(cell) * grid_size + g) * 3 + static_cast<std::size_t>(c)] /
+                                              (n * denominator));
+      }
       ++terms;
     }
   }
   if (terms == 0 || paths_ == 0) return p;
+  p.largest_share.assign(grid_size, std::nan(""));
+  for (std::size_t g = 0; g < grid_size; ++g) {
+    if (p.relative_second_moment[g] > 0.0) p.largest_share[g] = std::min(1.0, largest[g] / p.relative_second_moment[g]);
+    p.relative_second_moment[g] /= static_cast<double>(terms);
+  }
   // Cost at w' self-normalised by the mean of 1/R (whose expectation is 1): the
   // ratio estimate has less noise than the plain mean when R varies a lot. The
   // measured time per sample belongs to the plain mean cost at the sampling weight.
@@ -217,9 +236,20 @@ WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, cons
   out.cost.assign(n, 0.0);
   out.efficiency.assign(n, 0.0);
   double paths = 0.0;
+  // The largest path of all the parts' over the sum of all their terms: each
+  // part's largest is share * its mean * its paths, in the same units.
+  bool shares = true;
+  for (const WeightPrediction& p : parts)
+    shares = shares && p.largest_share.size() == n && p.relative_second_moment.size() == n;
+  std::vector<double> largest(shares ? n : 0, 0.0), total(largest.size(), 0.0);
   for (const WeightPrediction& p : parts) {
     if (p.weight != out.weight || p.relative_variance.size() != n || p.cost.size() != n) continue;
     const double k = static_cast<double>(p.paths);
+    for (std::size_t g = 0; g < largest.size(); ++g) {
+      const double sum = p.relative_second_moment[g] * k;
+      if (std::isfinite(p.largest_share[g])) largest[g] = std::max(largest[g], p.largest_share[g] * sum);
+      total[g] += sum;
+    }
     paths += k;
     out.paths += p.paths;
     out.sampling_cost += k * p.sampling_cost;
@@ -228,6 +258,14 @@ WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, cons
   if (!(paths > 0.0)) return out;
   out.sampling_cost /= paths;
   for (std::size_t g = 0; g < n; ++g) out.relative_variance[g] /= paths, out.cost[g] /= paths;
+  if (shares) {
+    out.largest_share.assign(n, std::nan(""));
+    out.relative_second_moment.assign(n, 0.0);
+    for (std::size_t g = 0; g < n; ++g) {
+      out.relative_second_moment[g] = total[g] / paths;
+      if (total[g] > 0.0) out.largest_share[g] = largest[g] / total[g];
+    }
+  }
   apply_cost_model(out, model);
   return out;
 }

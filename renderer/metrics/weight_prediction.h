@@ -48,6 +48,10 @@
 namespace pdflab {
 
 inline constexpr double kDefensiveFloor = 0.05;
+// Where the largest single path carries more than this share of a predicted
+// relative second moment, the prediction there is not to be trusted
+// (WeightPrediction::largest_share).
+inline constexpr double kDominantShare = 0.1;
 
 // Densities at one diffuse vertex for the direction it drew.
 struct MixtureVertex {
@@ -83,6 +87,14 @@ struct WeightPrediction {
   std::vector<double> efficiency;       // 1 / (relative_variance * seconds per pass); 0 where infinite variance
   std::uint64_t paths = 0;
   double sampling_cost = 0.0;           // mean cost of the recorded paths, at the sampling weight
+  // The max-to-sum ratio of the terms F^2 R / (mu^2 + eps) whose mean is the
+  // relative second moment: the largest single path's share of it, per grid
+  // weight. For nonnegative terms with a finite mean it falls towards 0 as
+  // paths are added (O'Brien 1980); where it stays large the second moment is
+  // infinite or carried by paths too rare for the sample, and the predicted
+  // variance is too low. Above kDominantShare the prediction is unreliable.
+  std::vector<double> largest_share;
+  std::vector<double> relative_second_moment;  // the mean of those terms (what largest_share divides)
   int best = -1;                        // index of the highest efficiency; -1 when none is finite
   double best_weight() const { return best >= 0 ? weight[static_cast<std::size_t>(best)] : -1.0; }
 };
@@ -187,6 +199,7 @@ class WeightPredictor {
   WeightFamily family_;
   std::vector<std::uint64_t> count_;   // per cell
   std::vector<double> moment_;         // per cell, grid point and channel: sum of F^2 R
+  std::vector<double> peak_;           // per cell, grid point and channel: the largest F^2 R
   std::vector<double> cost_sum_;       // per grid point: sum of cost / R
   std::vector<double> offset_sum_;     // per grid point: sum of 1 / R (should approach the path count)
   double plain_cost_sum_ = 0.0;        // sum of cost, at the sampling weight
