@@ -39,6 +39,7 @@ struct Result {
   std::vector<Checkpoint> curve;
   double weight = -1.0;     // with --predict: A's share of the pair; -1 outside the family
   double predicted = -1.0;  // the efficiency predicted from the pilot's paths; -1: none
+  double predicted_share = -1.0;  // the largest pilot path's share of that prediction's second moment; -1: none
 };
 
 // Samples per pixel of the pilot's run replayed for the prediction (as sweep).
@@ -246,6 +247,8 @@ int run_bench(const BenchOptions& o) {
         results[i].weight = prediction.weights[i];
         const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
         results[i].predicted = p.efficiency[static_cast<std::size_t>(g)];
+        if (static_cast<std::size_t>(g) < p.largest_share.size() && std::isfinite(p.largest_share[static_cast<std::size_t>(g)]))
+          results[i].predicted_share = p.largest_share[static_cast<std::size_t>(g)];
       }
   }
 
@@ -258,14 +261,15 @@ int run_bench(const BenchOptions& o) {
   // roulette_depth: where Russian roulette starts (0: off).
   std::string csv =
       "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased,relmse_raw,"
-      "relmse_ci,ref_share,roulette_depth,weight,predicted_efficiency\n";
+      "relmse_ci,ref_share,roulette_depth,weight,predicted_efficiency,predicted_largest_share\n";
   char line[512];
   for (const Result& r : results) {
     std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g,%.6g,%llu,%.6g,%d,%.6g,%.6g,%.6g,%d,", r.spp, r.seconds,
                   r.rmse, r.error.corrected, r.efficiency, r.samples_per_second,
                   static_cast<unsigned long long>(r.dropped), r.estimated_relmse, r.strategy.is_unbiased() ? 1 : 0,
                   r.error.raw, r.error.interval, r.error.reference_share(), r.strategy.roulette_depth);
-    csv += csv_field(r.strategy.to_string()) + line + optional_number(r.weight) + "," + optional_number(r.predicted) + "\n";
+    csv += csv_field(r.strategy.to_string()) + line + optional_number(r.weight) + "," + optional_number(r.predicted) + "," +
+           optional_number(r.predicted_share) + "\n";
   }
 
   std::string curves;
@@ -312,7 +316,8 @@ int run_bench(const BenchOptions& o) {
   for (const Result& r : results) {
     const double ratio = results[0].efficiency > 0 ? r.efficiency / results[0].efficiency : 0.0;
     char guess[32] = "";
-    if (predicted && r.predicted >= 0.0) std::snprintf(guess, sizeof guess, " %11.4g", r.predicted);
+    if (predicted && r.predicted >= 0.0)
+      std::snprintf(guess, sizeof guess, " %10.4g%s", r.predicted, r.predicted_share > kDominantShare ? "*" : " ");
     else if (predicted) std::snprintf(guess, sizeof guess, " %11s", "-");
     std::printf("%-36s %7u %8.2f %10.4g %10.4g %9.2g %10.4g %6.1f%% %10.4g %11.4g %7.2fx %9.3f %8llu%s%s\n",
                 r.strategy.to_string().c_str(), r.spp, r.seconds, r.rmse, r.error.corrected, r.error.interval,
@@ -331,6 +336,12 @@ int run_bench(const BenchOptions& o) {
                 prediction.pair.a.c_str(), prediction.pair.b.c_str(),
                 strategies[static_cast<std::size_t>(prediction.pilot)].to_string().c_str(), prediction.pair.a.c_str(),
                 prediction.weights[static_cast<std::size_t>(prediction.pilot)], prediction.pair.a.c_str(), predicted_best);
+  bool dominated = false;
+  for (const Result& r : results) dominated = dominated || r.predicted_share > kDominantShare;
+  if (dominated)
+    std::printf("*: one path carries more than %.0f%% of that prediction's second moment: there the moment is infinite or "
+                "carried by paths too rare for the replay, and the predicted efficiency is likely too high\n",
+                100.0 * kDominantShare);
   return 0;
 }
 

@@ -290,15 +290,19 @@ TEST_F(BenchCommand, PredictsTheMixturesEfficiencyFromThePilotsPaths) {
   std::vector<std::string> header;
   const auto rows = parse_csv(slurp(work() / "out.csv"), header);
   ASSERT_EQ(rows.size(), 5u);
-  ASSERT_EQ(header.back(), "predicted_efficiency");
+  ASSERT_EQ(header.back(), "predicted_largest_share");
   const double expected_weight[4] = {1.0, 0.3, 0.5, 0.8};
   for (int i = 0; i < 4; ++i) {
     EXPECT_NEAR(std::stod(rows[static_cast<std::size_t>(i)].at("weight")), expected_weight[i], 1e-9) << i;
     EXPECT_GT(std::stod(rows[static_cast<std::size_t>(i)].at("predicted_efficiency")), 0.0) << i;
+    const double share = std::stod(rows[static_cast<std::size_t>(i)].at("predicted_largest_share"));
+    EXPECT_GT(share, 0.0) << i;
+    EXPECT_LE(share, 1.0) << i;
   }
   // uniform-sphere is no mixture of cosine and light: no weight, no prediction.
   EXPECT_EQ(rows[4].at("weight"), "");
   EXPECT_EQ(rows[4].at("predicted_efficiency"), "");
+  EXPECT_EQ(rows[4].at("predicted_largest_share"), "");
   const double measured = std::stod(rows[2].at("efficiency")), predicted = std::stod(rows[2].at("predicted_efficiency"));
   EXPECT_NEAR(predicted / measured, 1.0, 0.4) << "measured " << measured << ", predicted " << predicted;
   EXPECT_NE(r.out.find("predicted best share of cosine"), std::string::npos) << r.out;
