@@ -714,19 +714,19 @@ int run_sweep(const SweepOptions& o) {
                     100.0 * kDominantShare);
       tail.label = tail_label;
       tail.dashed = true;
+      const auto dominated = [&](std::size_t i) {
+        return i < pooled.largest_share.size() && pooled.largest_share[i] > kDominantShare;
+      };
       for (std::size_t g = 0; g < grid.size(); ++g) {
         if (!(grid[g] >= weights.front() && grid[g] <= weights.back() && predicted_curve[g] > 0.0)) continue;
-        const auto dominated = [&](std::size_t i) {
-          return i < pooled.largest_share.size() && pooled.largest_share[i] > kDominantShare;
-        };
-        const bool heavy_here = dominated(g);
-        // Both series share the boundary points, so the curve stays whole.
-        const bool heavy_next = dominated(g + 1), heavy_prev = g > 0 && dominated(g - 1);
-        if (!heavy_here || !heavy_next || !heavy_prev) predicted.x.push_back(grid[g]), predicted.y.push_back(predicted_curve[g]);
-        if (heavy_here || heavy_next || heavy_prev) tail.x.push_back(grid[g]), tail.y.push_back(predicted_curve[g]);
+        // A gap (NaN) in each line where the other runs; a trusted point next
+        // to a dominated one is in both, so the curve stays whole.
+        const bool here = dominated(g), beside = (g > 0 && dominated(g - 1)) || dominated(g + 1);
+        predicted.x.push_back(grid[g]), predicted.y.push_back(here ? std::nan("") : predicted_curve[g]);
+        tail.x.push_back(grid[g]), tail.y.push_back(here || beside ? predicted_curve[g] : std::nan(""));
       }
       series.push_back(predicted);
-      if (!tail.x.empty()) series.push_back(tail);
+      if (std::any_of(tail.y.begin(), tail.y.end(), [](double v) { return std::isfinite(v); })) series.push_back(tail);
     }
     plot = linear_svg(series, po);
   }

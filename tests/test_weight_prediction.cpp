@@ -103,7 +103,9 @@ TEST(WeightPrediction, SecondMomentAtOtherWeightsMatchesQuadrature) {
 // ratio). B's pdf is 3x^2 here and f = 1: at w' = 0 a term is 1 / (p_w(x)
 // 3x^2), P(term > t) ~ t^(-1/2), no finite mean, and one path keeps a large
 // share however many are drawn; at every other weight the terms are bounded
-// and the share falls like 1 / paths. Pooling parts keeps the verdict.
+// and the share falls like 1 / paths. A path that B alone cannot draw (b = 0)
+// makes the moment at w' = 0 infinite: one path is all of it. Pooling parts
+// keeps the verdict.
 TEST(WeightPrediction, LargestShareFlagsTheInfiniteMoment) {
   const std::vector<double> grid = pdflab::weight_grid(11);
   const double w = 0.5;
@@ -120,6 +122,11 @@ TEST(WeightPrediction, LargestShareFlagsTheInfiniteMoment) {
       const MixtureVertex v{1.0f, static_cast<float>(3.0 * x * x), 0.0f};
       p.add_path(0, rgb, {&v, 1}, 1.0);
     }
+    if (seed == 22u) {
+      const float rgb[3] = {1.0f, 1.0f, 1.0f};
+      const MixtureVertex v{1.0f, 0.0f, 0.0f};
+      p.add_path(0, rgb, {&v, 1}, 1.0);
+    }
     parts.push_back(p.predict({1.0f, 1.0f, 1.0f}, 0.0, 0.0));
   }
   const pdflab::WeightPrediction pooled = pdflab::pooled_prediction(parts, pdflab::kRaysAlone);
@@ -128,11 +135,15 @@ TEST(WeightPrediction, LargestShareFlagsTheInfiniteMoment) {
     EXPECT_GT(p.largest_share[0], pdflab::kDominantShare);
     for (std::size_t g = 1; g < grid.size(); ++g) EXPECT_LT(p.largest_share[g], 1e-3) << grid[g];
   }
-  // The pooled share is the largest path of both parts over their summed terms.
-  const double largest = std::max(parts[0].largest_share[5] * parts[0].relative_second_moment[5],
-                                  parts[1].largest_share[5] * parts[1].relative_second_moment[5]);
-  EXPECT_NEAR(pooled.largest_share[5],
-              largest / (parts[0].relative_second_moment[5] + parts[1].relative_second_moment[5]), 1e-12);
+  EXPECT_LT(parts[0].largest_share[0], 1.0);
+  EXPECT_EQ(parts[1].largest_share[0], 1.0);
+  EXPECT_EQ(pooled.largest_share[0], 1.0);
+  // The pooled share is the largest path of both parts over their summed
+  // terms, each part's in units of its own paths.
+  const std::size_t red = 5 * 3;  // w' = 0.5, channel 0
+  const double k0 = static_cast<double>(parts[0].paths), k1 = static_cast<double>(parts[1].paths);
+  const double largest = std::max(parts[0].largest_term_rgb[red] * k0, parts[1].largest_term_rgb[red] * k1);
+  EXPECT_NEAR(pooled.largest_share[5], largest / (parts[0].moment_rgb[red] * k0 + parts[1].moment_rgb[red] * k1), 1e-12);
 }
 
 TEST(WeightPrediction, PredictedOptimumIsTheTrueOne) {

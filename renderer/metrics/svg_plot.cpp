@@ -205,8 +205,17 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
     const auto& s = series[k];
     const std::string colour = kColours[k % (sizeof kColours / sizeof kColours[0])];
     std::string points;
+    const auto flush = [&] {
+      if (!points.empty())
+        svg += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\"" +
+               (s.dashed ? " stroke-dasharray=\"6,4\"" : "") + " points=\"" + points + "\"/>\n";
+      points.clear();
+    };
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) {
+        flush();  // a gap in the line
+        continue;
+      }
       const std::string cx = fmt("%.1f", px(s.x[i])), cy = fmt("%.1f", py(s.y[i]));
       points += cx + "," + cy + " ";
       if (i < s.y_lo.size() && i < s.y_hi.size() && std::isfinite(s.y_lo[i]) && std::isfinite(s.y_hi[i]))
@@ -214,8 +223,7 @@ std::string linear_svg(const std::vector<PlotSeries>& series, const PlotOptions&
                "\" y2=\"" + fmt("%.1f", py(s.y_hi[i])) + "\" stroke=\"" + colour + "\" stroke-width=\"1.2\"/>\n";
       if (!s.dashed) svg += "<circle cx=\"" + cx + "\" cy=\"" + cy + "\" r=\"3\" fill=\"" + colour + "\"/>\n";
     }
-    svg += "<polyline fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\"" +
-           (s.dashed ? " stroke-dasharray=\"6,4\"" : "") + " points=\"" + points + "\"/>\n";
+    flush();
     legend(colour, s.label, s.dashed);
   }
   if (std::isfinite(o.marker_x)) {

@@ -9,7 +9,8 @@ namespace pdflab {
 struct PlotSeries {
   std::string label;
   std::vector<double> x, y;  // points with x <= 0 or y <= 0 are skipped (log axes)
-  // Linear plots only: an error bar per point (empty: none), a dashed line.
+  // Linear plots only: an error bar per point (empty: none), a dashed line;
+  // a point whose x or y is not finite breaks the line there.
   std::vector<double> y_lo, y_hi;
   bool dashed = false;
 };

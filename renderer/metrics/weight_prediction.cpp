@@ -10,6 +10,19 @@
 
 namespace pdflab {
 
+std::vector<double> largest_shares(const std::vector<double>& moment_rgb, const std::vector<double>& largest_term_rgb) {
+  std::vector<double> share(moment_rgb.size() / 3, std::nan(""));
+  for (std::size_t g = 0; g < share.size(); ++g)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double sum = moment_rgb[g * 3 + c], top = largest_term_rgb[g * 3 + c];
+      if (!(sum > 0.0)) continue;
+      // An infinite moment (a path the weight cannot draw) or term: one path is all of it.
+      const double s = std::isfinite(sum) && std::isfinite(top) ? std::min(1.0, top / sum) : 1.0;
+      share[g] = std::isnan(share[g]) ? s : std::max(share[g], s);
+    }
+  return share;
+}
+
 std::vector<double> weight_grid(int points) {
   std::vector<double> grid;
   if (points < 2) return {0.5};
@@ -62,7 +75,10 @@ void WeightPredictor::add_path(int cell, const float rgb[3], std::span<const Mix
     const double after = (k + 1 < vertices.size() ? static_cast<double>(vertices[k + 1].segments) : cost) -
                          static_cast<double>(v.segments);
     for (std::size_t g = 0; g < grid_size; ++g) {
-      if (family_.roulette && m > 0.0) ratio_[g] *= q_here / std::min(1.0, m * ratio_[g]);  // survived the check
+      if (family_.roulette && m > 0.0) {  // survived the check
+        const double q_there = std::min(1.0, m * ratio_[g]);
+        if (q_there > 0.0) ratio_[g] *= q_here / q_there;  // (0 only where the path had density 0 at w)
+      }
       const double there = family_.pdf(v, grid_[g]);
       ratio_[g] *= there > 0.0 ? here / there : std::numeric_limits<double>::infinity();
       if (family_.roulette) path_cost_[g] += after / ratio_[g];
@@ -124,8 +140,9 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
   p.relative_variance.assign(grid_size, 0.0);
   p.cost.assign(grid_size, 0.0);
   p.efficiency.assign(grid_size, 0.0);
-  p.relative_second_moment.assign(grid_size, 0.0);
-  std::vector<double> largest(grid_size, 0.0);  // the largest path's part of the sum over cells and channels
+  // Per grid point and channel: the sum over cells of M / (mu^2 + eps), and
+  // the largest single path's part of it.
+  std::vector<double> sum_rgb(grid_size * 3, 0.0), largest_rgb(grid_size * 3, 0.0);
   std::size_t terms = 0;
   for (int cell = 0; cell < cells_; ++cell) {
     if (count_[static_cast<std::size_t>(cell)] == 0) continue;
@@ -142,22 +159,23 @@ WeightPrediction WeightPredictor::predict(const std::vector<float>& mean_rgb, do
       for (std::size_t g = 0; g < grid_size; ++g) {
         const double m = second_moment(cell, g, c);
         p.relative_variance[g] += (m - mu2) / denominator;
-        p.relative_second_moment[g] += m / denominator;
-        largest[g] = std::max(largest[g], peak_[(static_cast<std::size_t>(cell) * grid_size + g) * 3 + static_cast<std::size_t>(c)] /
-                                              (n * denominator));
+        const std::size_t k = g * 3 + static_cast<std::size_t>(c);
+        sum_rgb[k] += m / denominator;
+        largest_rgb[k] = std::max(
+            largest_rgb[k], peak_[(static_cast<std::size_t>(cell) * grid_size + g) * 3 + static_cast<std::size_t>(c)] / (n * denominator));
       }
       ++terms;
     }
   }
   if (terms == 0 || paths_ == 0) return p;
-  p.largest_share.assign(grid_size, std::nan(""));
-  for (std::size_t g = 0; g < grid_size; ++g) {
-    if (p.relative_second_moment[g] > 0.0) p.largest_share[g] = std::min(1.0, largest[g] / p.relative_second_moment[g]);
-    p.relative_second_moment[g] /= static_cast<double>(terms);
-  }
+  p.moment_rgb = std::move(sum_rgb);
+  p.largest_term_rgb = std::move(largest_rgb);
+  p.largest_share = largest_shares(p.moment_rgb, p.largest_term_rgb);
   // Cost at w' self-normalised by the mean of 1/R (whose expectation is 1): the
-  // ratio estimate has less noise than the plain mean when R varies a lot. The
-  // measured time per sample belongs to the plain mean cost at the sampling weight.
+  // ratio estimate has less noise than the plain mean when R varies a lot
+  // (with roulette, cost_sum_ holds the segment-by-segment sums and
+  // offset_sum_ the path count: a plain mean). The measured time per sample
+  // belongs to the plain mean cost at the sampling weight.
   const double cost_here = plain_cost_sum_ / static_cast<double>(paths_);
   p.sampling_cost = cost_here;
   double best = -1.0;
@@ -236,19 +254,18 @@ WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, cons
   out.cost.assign(n, 0.0);
   out.efficiency.assign(n, 0.0);
   double paths = 0.0;
-  // The largest path of all the parts' over the sum of all their terms: each
-  // part's largest is share * its mean * its paths, in the same units.
-  bool shares = true;
-  for (const WeightPrediction& p : parts)
-    shares = shares && p.largest_share.size() == n && p.relative_second_moment.size() == n;
-  std::vector<double> largest(shares ? n : 0, 0.0), total(largest.size(), 0.0);
+  // The largest path of all the parts' over the sum of all their terms, per
+  // channel: each part's largest term and sum are in units of its own paths
+  // per cell, so both are counted by its paths.
+  std::vector<double> largest(n * 3, 0.0), total(n * 3, 0.0);
+  bool shares = false;
   for (const WeightPrediction& p : parts) {
     if (p.weight != out.weight || p.relative_variance.size() != n || p.cost.size() != n) continue;
     const double k = static_cast<double>(p.paths);
-    for (std::size_t g = 0; g < largest.size(); ++g) {
-      const double sum = p.relative_second_moment[g] * k;
-      if (std::isfinite(p.largest_share[g])) largest[g] = std::max(largest[g], p.largest_share[g] * sum);
-      total[g] += sum;
+    if (p.moment_rgb.size() == n * 3 && p.largest_term_rgb.size() == n * 3) {
+      shares = true;
+      for (std::size_t i = 0; i < n * 3; ++i)
+        largest[i] = std::max(largest[i], p.largest_term_rgb[i] * k), total[i] += p.moment_rgb[i] * k;
     }
     paths += k;
     out.paths += p.paths;
@@ -259,12 +276,10 @@ WeightPrediction pooled_prediction(std::span<const WeightPrediction> parts, cons
   out.sampling_cost /= paths;
   for (std::size_t g = 0; g < n; ++g) out.relative_variance[g] /= paths, out.cost[g] /= paths;
   if (shares) {
-    out.largest_share.assign(n, std::nan(""));
-    out.relative_second_moment.assign(n, 0.0);
-    for (std::size_t g = 0; g < n; ++g) {
-      out.relative_second_moment[g] = total[g] / paths;
-      if (total[g] > 0.0) out.largest_share[g] = largest[g] / total[g];
-    }
+    for (std::size_t i = 0; i < n * 3; ++i) largest[i] /= paths, total[i] /= paths;
+    out.largest_share = largest_shares(total, largest);
+    out.moment_rgb = std::move(total);
+    out.largest_term_rgb = std::move(largest);
   }
   apply_cost_model(out, model);
   return out;

@@ -74,6 +74,11 @@ struct WeightFamily {
   }
 };
 
+// WeightPrediction::largest_share from the per-channel sums and largest terms:
+// per grid point the largest over channels of largest / sum (1 where either is
+// infinite, NaN where no channel has a moment).
+std::vector<double> largest_shares(const std::vector<double>& moment_rgb, const std::vector<double>& largest_term_rgb);
+
 // The grid of weights w' the prediction covers: `points` evenly spaced on [0, 1].
 std::vector<double> weight_grid(int points);
 
@@ -93,8 +98,13 @@ struct WeightPrediction {
   // paths are added (O'Brien 1980); where it stays large the second moment is
   // infinite or carried by paths too rare for the sample, and the predicted
   // variance is too low. Above kDominantShare the prediction is unreliable.
+  // Per channel the largest of its channel's terms over their sum: a path
+  // that carries a whole grey pixel's moment reads 100 %, not a third.
   std::vector<double> largest_share;
-  std::vector<double> relative_second_moment;  // the mean of those terms (what largest_share divides)
+  // Per grid point and channel (3 values each): the sum over cells of M /
+  // (mu^2 + eps), and the largest single path's part of it, what
+  // largest_share divides and what pooled_prediction pools.
+  std::vector<double> moment_rgb, largest_term_rgb;
   int best = -1;                        // index of the highest efficiency; -1 when none is finite
   double best_weight() const { return best >= 0 ? weight[static_cast<std::size_t>(best)] : -1.0; }
 };
@@ -166,6 +176,8 @@ class WeightPredictor {
 
   // One path: its estimate (RGB) at the sampling weight, the densities at each
   // of its diffuse vertices, its cost (e.g. the number of rays it traced).
+  // With roulette (WeightFamily::roulette) each vertex's `roulette` and
+  // `segments` must be filled in, and `cost` counts segments.
   void add_path(int cell, const float rgb[3], std::span<const MixtureVertex> vertices, double cost);
   void merge(const WeightPredictor& other);  // same cells, grid, weight and family
   void clear();
@@ -200,8 +212,8 @@ class WeightPredictor {
   std::vector<std::uint64_t> count_;   // per cell
   std::vector<double> moment_;         // per cell, grid point and channel: sum of F^2 R
   std::vector<double> peak_;           // per cell, grid point and channel: the largest F^2 R
-  std::vector<double> cost_sum_;       // per grid point: sum of cost / R
-  std::vector<double> offset_sum_;     // per grid point: sum of 1 / R (should approach the path count)
+  std::vector<double> cost_sum_;       // per grid point: sum of cost / R (with roulette: of the segment-by-segment cost)
+  std::vector<double> offset_sum_;     // per grid point: sum of 1 / R, which should approach the path count (with roulette: the count)
   double plain_cost_sum_ = 0.0;        // sum of cost, at the sampling weight
   std::vector<double> ratio_;          // scratch: R per grid point for the path being added
   std::vector<double> path_cost_;      // scratch: with roulette, the path's cost at each grid point
