@@ -88,23 +88,28 @@ std::vector<float> mean_image(const Scene& scene) {
   return mean;
 }
 
+// Paths drawn at cosine's share w of cosine and light, `suffix` after the
+// mixture (e.g. "+rr:1").
+WeightPredictor drawn_at(const Scene& scene, double w, const std::string& suffix, const std::vector<double>& grid,
+                         const WeightPathOptions& o) {
+  char text[64];
+  std::snprintf(text, sizeof text, "mix:cosine=%g,light=%g", w, 1.0 - w);
+  return record_weight_paths(scene, cosine_light(), Strategy::parse(text + suffix), w, grid, o);
+}
+
 TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
   const Scene scene = small_box(12);
-  const MixtureFamily family = cosine_light();
   WeightPathOptions o;
   o.samples = 512;
   o.threads = 2;
   // The mean per pixel: from many paths at 0.5 (it does not depend on the weight).
   const std::vector<double> grid = {0.25, 0.5, 0.8};
   o.seed = 11;
-  const WeightPredictor drawn_half = record_weight_paths(scene, family, Strategy::parse("mix:cosine=0.5,light=0.5"),
-                                                         0.5, grid, o);
+  const WeightPredictor drawn_half = drawn_at(scene, 0.5, "", grid, o);
   const std::vector<float> mean = mean_image(scene);
   for (double w : {0.25, 0.8}) {
     o.seed = 21;
-    char text[64];
-    std::snprintf(text, sizeof text, "mix:cosine=%g,light=%g", w, 1.0 - w);
-    const WeightPredictor drawn_there = record_weight_paths(scene, family, Strategy::parse(text), w, grid, o);
+    const WeightPredictor drawn_there = drawn_at(scene, w, "", grid, o);
     const std::size_t g = w < 0.5 ? 0 : 2;
     const double predicted = image_moment(drawn_half, g, mean);
     const double measured = image_moment(drawn_there, g, mean);
@@ -120,21 +125,17 @@ TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
 // measured there, with roulette from the first vertex on.
 TEST(WeightPaths, PredictionWithRussianRouletteMatchesTheMeasuredOne) {
   const Scene scene = small_box(12, 4);
-  const MixtureFamily family = cosine_light();
   WeightPathOptions o;
   o.samples = 2048;  // the moments of 512 spread by 5-10 % from seed to seed
   o.threads = 2;
   const std::vector<double> grid = {0.25, 0.5, 0.8};
   o.seed = 11;
-  const WeightPredictor drawn_half =
-      record_weight_paths(scene, family, Strategy::parse("mix:cosine=0.5,light=0.5+rr:1"), 0.5, grid, o);
+  const WeightPredictor drawn_half = drawn_at(scene, 0.5, "+rr:1", grid, o);
   const std::vector<float> mean = mean_image(scene);
   const WeightPrediction half = drawn_half.predict(mean, 0.0, 0.01);
   for (double w : {0.25, 0.8}) {
     o.seed = 21;
-    char text[64];
-    std::snprintf(text, sizeof text, "mix:cosine=%g,light=%g+rr:1", w, 1.0 - w);
-    const WeightPredictor drawn_there = record_weight_paths(scene, family, Strategy::parse(text), w, grid, o);
+    const WeightPredictor drawn_there = drawn_at(scene, w, "+rr:1", grid, o);
     const std::size_t g = w < 0.5 ? 0 : 2;
     const double measured = image_moment(drawn_there, g, mean);
     EXPECT_NEAR(image_moment(drawn_half, g, mean), measured, 0.1 * measured) << "at " << w;
