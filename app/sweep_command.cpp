@@ -710,8 +710,7 @@ int run_sweep(const SweepOptions& o) {
       // is likely too high (the sweep's stdout says why).
       PlotSeries tail;
       char tail_label[96];
-      std::snprintf(tail_label, sizeof tail_label, "predicted, one path > %.0f%% of the moment: likely too high",
-                    100.0 * kDominantShare);
+      std::snprintf(tail_label, sizeof tail_label, "predicted, one path > %.0f%%: likely too high", 100.0 * kDominantShare);
       tail.label = tail_label;
       tail.dashed = true;
       const auto dominated = [&](std::size_t i) {

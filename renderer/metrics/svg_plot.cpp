@@ -48,8 +48,11 @@ struct Frame {
     svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) + "\" height=\"" +
           std::to_string(o.height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
     svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-    svg += "<text x=\"" + fmt("%.1f", left + pw / 2) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
-           escape(o.title) + "</text>\n";
+    // Centred over the plot, but never past the left edge when a wide legend
+    // leaves the plot narrower than the title (about 0.55 em a character).
+    const double half_title = 0.5 * 0.55 * 15.0 * static_cast<double>(o.title.size());
+    svg += "<text x=\"" + fmt("%.1f", std::max(left + pw / 2, 8.0 + half_title)) +
+           "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" + escape(o.title) + "</text>\n";
     legend_y = top + 10;
   }
   void vertical_grid(double x, const std::string& label) {
