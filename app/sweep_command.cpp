@@ -510,10 +510,11 @@ int run_sweep(const SweepOptions& o) {
     return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
   };
   std::vector<double> row_rays(rows.size(), std::nan("")), row_seconds_per_sample(rows.size(), std::nan(""));
-  // The rays at each weight pooled over the pilot's seeds as the curve is
-  // (each seed counted by its paths; the pricing does not change them).
-  const std::vector<double> pooled_rays =
-      predictions.empty() ? std::vector<double>{} : pooled_prediction(predictions, kRaysAlone).cost;
+  // The pilot's seeds pooled once (pooled_prediction, each counted by its
+  // paths): the pool's rays at each weight go into the cost fit, and the pool
+  // priced by the fitted model is the predicted curve (below).
+  WeightPrediction pooled = pooled_prediction(predictions, kRaysAlone);
+  const std::vector<double>& pooled_rays = pooled.cost;
   CostFit cost_fit;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     row_seconds_per_sample[i] = interval(per_sample[i]).mean;
@@ -560,7 +561,7 @@ int run_sweep(const SweepOptions& o) {
   std::vector<double> predicted_best;
   for (const WeightPrediction& p : predictions)
     if (p.best >= 0) predicted_best.push_back(p.best_weight());
-  const WeightPrediction pooled = pooled_prediction(predictions, cost_model);
+  if (pooled.paths > 0) apply_cost_model(pooled, cost_model);  // as pooled_prediction prices a pool with paths
   WeightPrediction rays_only = pooled;
   if (!predictions.empty()) apply_cost_model(rays_only, CostModel{0.0, pilot_seconds / pooled.sampling_cost, false});
   const std::vector<double>& predicted_rays = pooled.cost;
