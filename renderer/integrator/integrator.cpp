@@ -64,11 +64,16 @@ bool scatter_specular(const SamplingPlan& plan, int depth, const Material& m, co
   return true;
 }
 
-// Russian roulette at a diffuse vertex reached by segment `depth`, before the
-// continuation (segment depth + 1) is drawn (leaf::russian_roulette): whether
-// the path goes on. Draws its random number only where it applies.
+// Whether Russian roulette checks a diffuse vertex reached by segment
+// `depth`, before its continuation (segment depth + 1) is drawn.
+bool roulette_checks(const SamplingPlan& plan, int depth) {
+  return plan.roulette_depth > 0 && depth + 1 >= plan.roulette_depth;
+}
+
+// Russian roulette at such a vertex (leaf::russian_roulette): whether the path
+// goes on. Draws its random number only where it applies.
 bool roulette_survives(const SamplingPlan& plan, int depth, Vec3& throughput, const Vec3& albedo, Rng& rng) {
-  if (plan.roulette_depth <= 0 || depth + 1 < plan.roulette_depth) return true;
+  if (!roulette_checks(plan, depth)) return true;
   return leaf::russian_roulette(throughput, albedo, rng.uniform());
 }
 
@@ -216,7 +221,7 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
       // Sampled, and its pdf evaluated, from the point the ray leaves from.
       const Vec3 origin = diffuse_origin(hit, normal);
       float roulette = 0.0f;  // recorded: q before the cut, where a check is taken
-      if (record && plan.roulette_depth > 0 && depth + 1 >= plan.roulette_depth) {
+      if (record && roulette_checks(plan, depth)) {
         roulette = leaf::roulette_largest(throughput, m.albedo);
         if (!std::isfinite(roulette)) roulette = 0.0f;  // survives at every weight (and is dropped)
       }
