@@ -161,8 +161,6 @@ class AutoWeight {
   // a first pass). What the viewer's curve shows; `used`, if given, receives
   // that model.
   WeightPrediction priced(WeightPrediction prediction, double seconds_per_sample, CostModel* used = nullptr) const;
-  // The model priced() uses for a prediction with this time per sample.
-  CostModel pricing_model(const WeightPrediction& prediction, double seconds_per_sample) const;
   const std::vector<double>& grid() const { return grid_; }
   const std::vector<double>& history() const { return history_; }  // the first guess, then one weight per add_pass
   const CostModel& cost_model() const { return model_; }           // the latest fit (zero before a timed pass)
@@ -175,6 +173,8 @@ class AutoWeight {
   CostModel model_;
   std::vector<double> history_;
   std::vector<bool> chosen_;  // per history_ entry: chosen by a prediction
+  // The model priced() uses for a prediction with this time per sample.
+  CostModel pricing_model(const WeightPrediction& prediction, double seconds_per_sample) const;
 };
 
 }  // namespace pdflab
