@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -87,11 +90,8 @@ Comparison compare(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, 
   return c;
 }
 
-std::vector<PacketIsa> isas() {
-  std::vector<PacketIsa> v{PacketIsa::Generic};
-  if (best_packet_isa() == PacketIsa::Avx2) v.push_back(PacketIsa::Avx2);
-  return v;
-}
+// Every instruction set this machine runs.
+std::vector<PacketIsa> isas() { return available_packet_isas(); }
 
 TEST(Packet, SameBitsAsTheScalarTracerOnEveryScene) {
   for (const char* file : kScenes) {
@@ -101,7 +101,7 @@ TEST(Packet, SameBitsAsTheScalarTracerOnEveryScene) {
       const SamplingPlan plan = SamplingPlan::make(Strategy::parse(text), scene);
       for (PacketIsa isa : isas()) {
         const Comparison c = compare(isa, scene, plan, 5, SampleBlock{0, 0, 24, 20, 3, 4});
-        SCOPED_TRACE(std::string(file) + ", " + text + (isa == PacketIsa::Avx2 ? ", avx2" : ", generic"));
+        SCOPED_TRACE(std::string(file) + ", " + text + ", " + std::string(packet_isa_name(isa)));
         // Two primitives at exactly the same distance (where walls meet) may be
         // resolved differently: at most one sample in a thousand.
         EXPECT_LE(c.differing * 1000, c.samples) << c.differing << " of " << c.samples << " differ; first at "
@@ -146,6 +146,25 @@ TEST(Packet, DepthLimitsAndDropsAsTheScalarTracer) {
   for (PacketIsa isa : isas()) {
     const Comparison c = compare(isa, flat, plan, 4, SampleBlock{0, 0, 16, 16, 0, 4});
     EXPECT_LE(c.differing * 1000, c.samples) << c.first_difference;
+  }
+}
+
+// The instruction sets: the baseline always, narrowest first, each wider than
+// the last; the tracer uses the widest unless PDFLAB_ISA names another. What
+// this machine ran is in the test's output (the bit comparisons above ran each).
+TEST(Packet, InstructionSetsAreListedWidestLast) {
+  const std::vector<PacketIsa> here = isas();
+  ASSERT_FALSE(here.empty());
+  EXPECT_EQ(here.front(), PacketIsa::Generic);
+  for (std::size_t i = 1; i < here.size(); ++i)
+    EXPECT_GT(packet_lanes(here[i]), packet_lanes(here[i - 1])) << packet_isa_name(here[i]);
+  std::string names;
+  for (const PacketIsa isa : here) names += std::string(names.empty() ? "" : ", ") + std::string(packet_isa_name(isa));
+  std::printf("instruction sets run here: %s\n", names.c_str());
+  const char* requested = std::getenv("PDFLAB_ISA");
+  if (!requested) EXPECT_EQ(best_packet_isa(), here.back());
+  if (std::find(here.begin(), here.end(), PacketIsa::Avx512) != here.end()) {
+    EXPECT_EQ(packet_lanes(PacketIsa::Avx512), 16);
   }
 }
 

@@ -57,11 +57,8 @@ DirectionSample one_path(const SamplingPlan& plan, const PlanDraw& d) {
   return to_direction_sample(leaf::sample_mixture(plan, at, chosen, true));
 }
 
-std::vector<PacketIsa> isas() {
-  std::vector<PacketIsa> v{PacketIsa::Generic};
-  if (best_packet_isa() == PacketIsa::Avx2) v.push_back(PacketIsa::Avx2);
-  return v;
-}
+// Every instruction set this machine runs.
+std::vector<PacketIsa> isas() { return available_packet_isas(); }
 
 TEST(Techniques, PacketDrawsTheOnePathBits) {
   const std::vector<PlanDraw> in = draws(203, 1);  // not a multiple of the lanes

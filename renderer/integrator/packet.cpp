@@ -6,20 +6,28 @@
 #include <numbers>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
+// GCC 12 warns inside its own AVX-512 header, where _mm512_undefined_ps and
+// its kin read a deliberately undefined register (GCC bug 105593): the
+// warning is about the header's lines, so it is turned off for them only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <immintrin.h>
+#pragma GCC diagnostic pop
 #define PDFLAB_PACKET_X86 1
 #else
 #define PDFLAB_PACKET_X86 0
 #endif
 
-// With GCC on x86-64 the kernel is compiled a second time for AVX2 (eight
-// lanes in one register, against four with SSE2), chosen at run time, so a
-// portable build still uses the machine it runs on. The arithmetic is the same
+// With GCC on x86-64 the kernel is compiled twice more, for AVX2 (eight lanes
+// in one register, against four with SSE2) and for AVX-512 (sixteen), and the
+// widest the machine has is chosen at run time, so a portable build still uses
+// the machine it runs on. The arithmetic is the same
 // IEEE operations in the same order either way (the build turns off FMA
-// contraction), so both give the same bits. Helpers from other headers are compiled for the baseline and may
-// be inlined into the AVX2 code, never the other way round.
+// contraction), so all give the same bits. Helpers from other headers are compiled for the baseline and may
+// be inlined into the wider code, never the other way round.
 #if PDFLAB_PACKET_X86 && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
 #define PDFLAB_PACKET_DISPATCH 1
 #else
@@ -34,43 +42,99 @@
 
 namespace pdflab {
 
-namespace packet_generic {
 #define PDFLAB_PACKET_AVX2 0
+#define PDFLAB_PACKET_AVX512 0
+namespace packet_generic {
 #include "renderer/integrator/packet_kernel.inc"
-#undef PDFLAB_PACKET_AVX2
 }  // namespace packet_generic
 
 #if PDFLAB_PACKET_DISPATCH
 #pragma GCC push_options
 #pragma GCC target("avx2")
-namespace packet_avx2 {
-#define PDFLAB_PACKET_AVX2 1
-#include "renderer/integrator/packet_kernel.inc"
 #undef PDFLAB_PACKET_AVX2
+#define PDFLAB_PACKET_AVX2 1
+namespace packet_avx2 {
+#include "renderer/integrator/packet_kernel.inc"
 }  // namespace packet_avx2
 #pragma GCC pop_options
+
+// AVX-512 Foundation and DQ (the 64-bit multiply of the random streams).
+#pragma GCC push_options
+#pragma GCC target("avx2,avx512f,avx512dq")
+#undef PDFLAB_PACKET_AVX2
+#define PDFLAB_PACKET_AVX2 0
+#undef PDFLAB_PACKET_AVX512
+#define PDFLAB_PACKET_AVX512 1
+namespace packet_avx512 {
+#include "renderer/integrator/packet_kernel.inc"
+}  // namespace packet_avx512
+#pragma GCC pop_options
 #endif
+#undef PDFLAB_PACKET_AVX2
+#undef PDFLAB_PACKET_AVX512
+
+namespace {
+// Whether this build has the kernel for `isa` and this machine (with its
+// operating system, which must save the wider registers) can run it.
+bool runs_here(PacketIsa isa) {
+  switch (isa) {
+    case PacketIsa::Generic:
+      return true;
+    case PacketIsa::Avx2:
+#if PDFLAB_PACKET_DISPATCH
+      return __builtin_cpu_supports("avx2");
+#elif defined(__AVX2__) && !defined(__AVX512F__)
+      return true;  // the baseline build already targets it
+#else
+      return false;
+#endif
+    case PacketIsa::Avx512:
+#if PDFLAB_PACKET_DISPATCH
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+#else
+      return false;
+#endif
+  }
+  return false;
+}
+}  // namespace
+
+std::vector<PacketIsa> available_packet_isas() {
+  std::vector<PacketIsa> v;
+  for (const PacketIsa isa : {PacketIsa::Generic, PacketIsa::Avx2, PacketIsa::Avx512})
+    if (runs_here(isa)) v.push_back(isa);
+  return v;
+}
 
 PacketIsa best_packet_isa() {
-  // PDFLAB_ISA=generic keeps the baseline code (to compare, or to rule the wider code out).
+  // PDFLAB_ISA=generic, avx2 or avx512 caps the choice (to compare, or to rule the wider code out).
   static const PacketIsa isa = [] {
+    const std::vector<PacketIsa> here = available_packet_isas();
+    PacketIsa best = here.back();
     const char* requested = std::getenv("PDFLAB_ISA");
-    if (requested && std::string_view(requested) == "generic") return PacketIsa::Generic;
-#if PDFLAB_PACKET_DISPATCH
-    return __builtin_cpu_supports("avx2") ? PacketIsa::Avx2 : PacketIsa::Generic;
-#elif defined(__AVX2__)
-    return PacketIsa::Avx2;  // the baseline build already targets it
-#else
-    return PacketIsa::Generic;
-#endif
+    if (!requested) return best;
+    for (const PacketIsa cap : here)
+      if (packet_isa_name(cap) == requested) return cap;
+    return best;
   }();
   return isa;
 }
 
-std::string_view packet_isa_name(PacketIsa isa) { return isa == PacketIsa::Avx2 ? "avx2" : "generic"; }
+std::string_view packet_isa_name(PacketIsa isa) {
+  switch (isa) {
+    case PacketIsa::Avx2:
+      return "avx2";
+    case PacketIsa::Avx512:
+      return "avx512";
+    case PacketIsa::Generic:
+      break;
+  }
+  return "generic";
+}
 
 int packet_lanes(PacketIsa isa) {
 #if PDFLAB_PACKET_DISPATCH
+  if (isa == PacketIsa::Avx512) return packet_avx512::W;
   if (isa == PacketIsa::Avx2) return packet_avx2::W;
 #else
   (void)isa;
@@ -78,10 +142,11 @@ int packet_lanes(PacketIsa isa) {
   return packet_generic::W;
 }
 
-// Calls the kernel compiled for `isa` (AVX2 only where the build dispatches).
+// Calls the kernel compiled for `isa` (AVX2 and AVX-512 only where the build dispatches).
 #if PDFLAB_PACKET_DISPATCH
-#define PDFLAB_PACKET_CALL(isa, call)                          \
-  if ((isa) == PacketIsa::Avx2) return packet_avx2::call; \
+#define PDFLAB_PACKET_CALL(isa, call)                              \
+  if ((isa) == PacketIsa::Avx512) return packet_avx512::call;   \
+  if ((isa) == PacketIsa::Avx2) return packet_avx2::call;       \
   return packet_generic::call
 #else
 #define PDFLAB_PACKET_CALL(isa, call) \

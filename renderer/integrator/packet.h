@@ -1,6 +1,6 @@
 #pragma once
-// The book's estimator for several paths at once: eight with AVX2, four with
-// SSE2 or NEON. Each SIMD lane carries one path; a lane whose path ends takes
+// The book's estimator for several paths at once: sixteen with AVX-512, eight
+// with AVX2, four with SSE2 or NEON. Each SIMD lane carries one path; a lane whose path ends takes
 // the next pixel sample at once, so the lanes stay full. Intersection (every
 // primitive against all the lanes' rays), hits, emission, the diffuse bounce's
 // sampling and mixture pdf, glass, metal and the spawned rays run for all
@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace pdflab {
 
@@ -35,9 +36,13 @@ struct SampleResult {
   std::uint8_t drops;  // bit r: the sample was dropped for DropReason r
 };
 
-enum class PacketIsa : std::uint8_t { Generic, Avx2 };
+enum class PacketIsa : std::uint8_t { Generic, Avx2, Avx512 };
+// Every instruction set this build has a kernel for and this machine runs,
+// narrowest first (Generic always).
+std::vector<PacketIsa> available_packet_isas();
 // The instruction set trace_block uses: the widest this machine has, or the
-// baseline when the environment sets PDFLAB_ISA=generic.
+// one the environment names in PDFLAB_ISA (generic, avx2 or avx512) where it is
+// available.
 PacketIsa best_packet_isa();
 std::string_view packet_isa_name(PacketIsa isa);
 int packet_lanes(PacketIsa isa);  // paths traced together
