@@ -162,7 +162,9 @@ TEST(Packet, InstructionSetsAreListedWidestLast) {
   for (const PacketIsa isa : here) names += std::string(names.empty() ? "" : ", ") + std::string(packet_isa_name(isa));
   std::printf("instruction sets run here: %s\n", names.c_str());
   const char* requested = std::getenv("PDFLAB_ISA");
-  if (!requested) EXPECT_EQ(best_packet_isa(), here.back());
+  if (!requested) {
+    EXPECT_EQ(best_packet_isa(), here.back());
+  }
   if (std::find(here.begin(), here.end(), PacketIsa::Avx512) != here.end()) {
     EXPECT_EQ(packet_lanes(PacketIsa::Avx512), 16);
   }

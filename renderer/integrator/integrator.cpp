@@ -255,20 +255,29 @@ Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng,
 SampleSeed::SampleSeed(std::uint64_t seed_value)
     : rng_key(Rng::seed_key(seed_value)), scramble_key(mix64(seed_value ^ 0x5bd1e995u)) {}
 
+#include "renderer/integrator/pixel_sample.inc"
+
+namespace {
+// pixel_sample_numbers for one sample.
+struct OneSample {
+  using U64 = std::uint64_t;
+  using U32 = std::uint32_t;
+  using F = float;
+  static U32 low32(U64 x) { return static_cast<U32>(x); }
+  static U64 wide(U32 x) { return x; }
+  static F unit(U32 x) { return Rng::to_unit(x); }
+};
+}  // namespace
+
 PixelSampleStart begin_pixel_sample(const Scene& scene, const SampleSeed& seed, int x, int y,
                                     std::uint32_t sample_index) {
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(scene.camera.width) +
                               static_cast<std::uint64_t>(x);
-  // A random digital shift per pixel keeps the (0,2)-sequence's stratification
-  // and decorrelates neighbouring pixels.
-  const std::uint64_t scramble = mix64(seed.scramble_key + pixel);
-  const std::uint32_t sx = qmc::sobol(sample_index, 0) ^ static_cast<std::uint32_t>(scramble);
-  const std::uint32_t sy = qmc::sobol(sample_index, 1) ^ static_cast<std::uint32_t>(scramble >> 32);
-  const float jx = Rng::to_unit(sx), jy = Rng::to_unit(sy);
-  PixelSampleStart start{scene.camera.generate_ray(static_cast<float>(x) + jx, static_cast<float>(y) + jy),
-                         Rng::for_sample_keyed(seed.rng_key, pixel, sample_index)};
+  const PixelSampleNumbers<OneSample> n =
+      pixel_sample_numbers<OneSample>(seed, pixel, static_cast<float>(x), static_cast<float>(y), sample_index);
+  PixelSampleStart start{scene.camera.generate_ray(n.px, n.py), Rng::from_parts(n.rng_state, n.rng_increment)};
   start.rng.qmc_index = sample_index;
-  start.rng.qmc_seed = static_cast<std::uint32_t>(mix64(scramble));
+  start.rng.qmc_seed = n.qmc_seed;
   return start;
 }
 

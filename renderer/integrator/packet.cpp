@@ -1,3 +1,8 @@
+// Vectors of eight or sixteen lanes are passed between the kernel's inline
+// helpers only (and rng.h's, always inlined): the note that their ABI differs
+// without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include "renderer/integrator/packet.h"
 
 #include <array>
@@ -34,9 +39,6 @@
 #define PDFLAB_PACKET_DISPATCH 0
 #endif
 
-// Vectors of eight floats are passed between the kernel's inline helpers only;
-// the note that their ABI differs without AVX does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
 
 #include "renderer/sampling/sobol.h"  // its templates run on the kernel's vectors too
 

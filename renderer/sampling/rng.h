@@ -3,15 +3,26 @@
 // (seed, pixel, sample index), never on which thread renders it.
 #include <cstdint>
 
+// Always inlined where it runs on vectors: in the packet tracer it then
+// compiles inside its instruction set's target region, on its vectors whole.
+#if defined(__GNUC__)
+#define PDFLAB_LANES inline __attribute__((always_inline))
+#else
+#define PDFLAB_LANES inline
+#endif
+
 namespace pdflab {
 
 // SplitMix64 finaliser: a strong 64-bit mix, used to derive independent streams.
-constexpr std::uint64_t mix64(std::uint64_t x) {
+// For one word or for a vector of 64-bit lanes (the packet tracer's sample starts).
+template <class U>
+PDFLAB_LANES constexpr U mix64_lanes(U x) {
   x += 0x9e3779b97f4a7c15ULL;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
   return x ^ (x >> 31);
 }
+constexpr std::uint64_t mix64(std::uint64_t x) { return mix64_lanes(x); }
 
 // PCG32 (O'Neill's XSH RR 64/32 with a selectable stream): the same numbers as
 // pcg-cpp's pcg32 (tests/test_sampling_unit.cpp compares them), written out so
@@ -21,7 +32,7 @@ class Rng {
   static constexpr std::uint64_t kMultiplier = 6364136223846793005ULL;
 
   Rng(std::uint64_t seed, std::uint64_t stream)
-      : increment_((stream << 1) | 1u), state_((seed + increment_) * kMultiplier + increment_) {}
+      : increment_(stream_increment(stream)), state_(stream_start(seed, increment_)) {}
 
   // The stream for one pixel sample.
   static Rng for_sample(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample) {
@@ -30,8 +41,26 @@ class Rng {
   // The same with the seed's part computed once for many samples.
   static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed); }
   static Rng for_sample_keyed(std::uint64_t seed_key, std::uint64_t pixel, std::uint64_t sample) {
-    const std::uint64_t key = mix64(seed_key ^ (pixel * 0x9e3779b97f4a7c15ULL + sample));
-    return Rng(key, mix64(key ^ 0x632be59bd9b4e019ULL));
+    const std::uint64_t key = sample_key(seed_key, pixel, sample);
+    return Rng(key, sample_stream(key));
+  }
+  // for_sample_keyed's parts, for one word or for vectors of 64-bit lanes: the
+  // seed and stream of a pixel sample, and the state and increment they give.
+  template <class U>
+  PDFLAB_LANES static constexpr U sample_key(std::uint64_t seed_key, U pixel, U sample) {
+    return mix64_lanes(seed_key ^ (pixel * 0x9e3779b97f4a7c15ULL + sample));
+  }
+  template <class U>
+  PDFLAB_LANES static constexpr U sample_stream(U key) {
+    return mix64_lanes(key ^ 0x632be59bd9b4e019ULL);
+  }
+  template <class U>
+  PDFLAB_LANES static constexpr U stream_increment(U stream) {
+    return (stream << 1) | 1u;
+  }
+  template <class U>
+  PDFLAB_LANES static constexpr U stream_start(U seed, U increment) {
+    return (seed + increment) * kMultiplier + increment;
   }
 
   std::uint32_t next_u32() {
@@ -42,7 +71,13 @@ class Rng {
   // Uniform in [0, 1): 24 random bits, exact in float, never 1.
   float uniform() { return to_unit(next_u32()); }
 
-  // The parts, for stepping many streams in SIMD lanes.
+  // The parts, for stepping many streams in SIMD lanes, and back.
+  static Rng from_parts(std::uint64_t state, std::uint64_t increment) {
+    Rng r(0, 0);
+    r.state_ = state;
+    r.increment_ = increment;
+    return r;
+  }
   std::uint64_t state() const { return state_; }
   std::uint64_t increment() const { return increment_; }
   static std::uint32_t output(std::uint64_t old) {
