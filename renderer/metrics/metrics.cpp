@@ -123,7 +123,7 @@ namespace {
 // image-sized buffer is touched: a headless render's estimate).
 NoiseSummary sweep_noise(const Film& film, std::vector<float>* map, double epsilon, std::vector<float>* mean_rgb) {
   const std::size_t pixels = film.pixel_count();
-  if (map) map->assign(pixels, 0.0f);
+  if (map) map->resize(pixels);  // every pixel is written below
   if (mean_rgb) mean_rgb->resize(3 * pixels);
   double rse_sum = 0.0, rel_sum = 0.0;
   std::size_t n = 0;
@@ -135,7 +135,10 @@ NoiseSummary sweep_noise(const Film& film, std::vector<float>* map, double epsil
     film.moments(p, r, m, v);
     if (mean_rgb)
       for (int c = 0; c < 3; ++c) (*mean_rgb)[3 * p + c] = static_cast<float>(m[c]);
-    if (count < 2) continue;
+    if (count < 2) {
+      if (map) (*map)[p] = 0.0f;
+      continue;
+    }
     const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
     if (map) (*map)[p] = static_cast<float>(rse);
     rse_sum += rse;

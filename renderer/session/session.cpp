@@ -292,8 +292,9 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
         for (std::uint32_t s = 0; s < block.spp; ++s, ++r) {
           film_.add(pixel, r->radiance);
           dropped |= r->drops;
-          for (int reason = 0; reason < kDropReasonCount; ++reason)
-            if (r->drops & (1u << reason)) drops.add(static_cast<DropReason>(reason));
+          if (r->drops)
+            for (int reason = 0; reason < kDropReasonCount; ++reason)
+              if (r->drops & (1u << reason)) drops.add(static_cast<DropReason>(reason));
         }
         if (dropped) film_.mark_drops(pixel, dropped);
       }
