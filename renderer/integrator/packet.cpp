@@ -18,7 +18,9 @@
 // its kin read a deliberately undefined register (GCC bug 105593): the
 // warning is about the header's lines, so it is turned off for them only.
 #pragma GCC diagnostic push
+#if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <immintrin.h>
 #pragma GCC diagnostic pop
 #define PDFLAB_PACKET_X86 1
