@@ -5,6 +5,7 @@
 #include "renderer/film/film.h"
 #include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/integrator/packet.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
@@ -331,6 +332,9 @@ int run_render(const RenderOptions& o) {
     j["seed"] = seed;
     j["first_sample"] = first_sample;
     j["threads"] = session.thread_count();
+    // What the speed figures came from (the images are the same bits with any).
+    j["tracer"] = std::string(packet_isa_name(best_packet_isa()));
+    j["tracer_lanes"] = packet_lanes(best_packet_isa());
     j["seconds"] = st.seconds;
     j["samples"] = st.samples;
     j["samples_per_second"] = st.samples_per_second;

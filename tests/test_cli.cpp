@@ -2,6 +2,7 @@
 // each class of bad input exits 2 with one message naming the problem and
 // writes nothing; a small render writes the image, the stats JSON and a summary.
 #include "renderer/film/image_io.h"
+#include "renderer/integrator/packet.h"
 #include "tests/command_test.h"
 
 #include <gtest/gtest.h>
@@ -178,6 +179,8 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   EXPECT_EQ(stats.at("threads").get<int>(), 2);
   EXPECT_EQ(stats.at("strategy").get<std::string>(), "mix:cosine=0.5,light=0.5");
   EXPECT_EQ(stats.at("sampler").get<std::string>(), "independent");
+  EXPECT_EQ(stats.at("tracer").get<std::string>(), packet_isa_name(best_packet_isa()));
+  EXPECT_EQ(stats.at("tracer_lanes").get<int>(), packet_lanes(best_packet_isa()));
   EXPECT_EQ(stats.at("samples").get<std::uint64_t>(), 32u * 32u * 4u);
   const double seconds = stats.at("seconds").get<double>();
   const double rate = stats.at("samples_per_second").get<double>();
