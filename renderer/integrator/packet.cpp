@@ -41,7 +41,6 @@
 #define PDFLAB_PACKET_DISPATCH 0
 #endif
 
-
 #include "renderer/sampling/sobol.h"  // its templates run on the kernel's vectors too
 
 namespace pdflab {

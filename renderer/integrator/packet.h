@@ -1,12 +1,15 @@
 #pragma once
 // The book's estimator for several paths at once: sixteen with AVX-512, eight
-// with AVX2, four with SSE2 or NEON. Each SIMD lane carries one path; a lane whose path ends takes
-// the next pixel sample at once, so the lanes stay full. Intersection (every
-// primitive against all the lanes' rays), hits, emission, the diffuse bounce's
-// sampling and mixture pdf, glass, metal and the spawned rays run for all
-// lanes at once, as do nee-mis's shadow rays; each path's random numbers come
-// from its own stream (stepped for all lanes at once with AVX2), and the
-// spherical rectangles of light-sa and nee-mis are set up per lane in double.
+// with AVX2, four with SSE2 or NEON. Each SIMD lane carries one path; a lane
+// whose path ends takes the next pixel sample at once, so the lanes stay full
+// (the next samples' camera rays and streams are set up W at a time).
+// Intersection (every primitive against all the lanes' rays), hits, emission,
+// the diffuse bounce's sampling and mixture pdf, glass, metal and the spawned
+// rays run for all lanes at once, as do nee-mis's shadow rays; each path's
+// random numbers come from its own stream (stepped for all lanes at once with
+// AVX2 or AVX-512), and the spherical rectangles of light-sa and nee-mis are
+// set up for all lanes in float (a lane outside the float form's domain takes
+// the double form alone).
 //
 // Every operation mirrors trace_path's, in the same order and precision, and
 // a sample's random numbers come from its own stream as before, so a sample's
