@@ -90,16 +90,13 @@ Comparison compare(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, 
   return c;
 }
 
-// Every instruction set this machine runs.
-std::vector<PacketIsa> isas() { return available_packet_isas(); }
-
 TEST(Packet, SameBitsAsTheScalarTracerOnEveryScene) {
   for (const char* file : kScenes) {
     const Scene scene = small_scene(file, 24, 20);
     std::size_t samples = 0, nonzero = 0;
     for (const char* text : kStrategies) {
       const SamplingPlan plan = SamplingPlan::make(Strategy::parse(text), scene);
-      for (PacketIsa isa : isas()) {
+      for (PacketIsa isa : available_packet_isas()) {
         const Comparison c = compare(isa, scene, plan, 5, SampleBlock{0, 0, 24, 20, 3, 4});
         SCOPED_TRACE(std::string(file) + ", " + text + ", " + std::string(packet_isa_name(isa)));
         // Two primitives at exactly the same distance (where walls meet) may be
@@ -118,7 +115,7 @@ TEST(Packet, BlocksAnywhereInTheImage) {
   // An offset block with one sample per pixel, and one pixel with many.
   const Scene scene = small_scene("cornell_book.json", 40, 30);
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), scene);
-  for (PacketIsa isa : isas()) {
+  for (PacketIsa isa : available_packet_isas()) {
     Comparison c = compare(isa, scene, plan, 9, SampleBlock{17, 11, 30, 29, 0, 1});
     EXPECT_LE(c.differing * 1000, c.samples) << c.first_difference;
     c = compare(isa, scene, plan, 9, SampleBlock{20, 15, 21, 16, 100, 333});
@@ -133,7 +130,7 @@ TEST(Packet, DepthLimitsAndDropsAsTheScalarTracer) {
     for (const char* text : {"mix:cosine=0.5,light=0.5", "nee-mis"}) {
       scene.max_depth = depth;
       const SamplingPlan plan = SamplingPlan::make(Strategy::parse(text), scene);
-      for (PacketIsa isa : isas()) {
+      for (PacketIsa isa : available_packet_isas()) {
         const Comparison c = compare(isa, scene, plan, 2, SampleBlock{0, 0, 16, 16, 0, 2});
         EXPECT_EQ(c.differing, 0u) << text << ", depth " << depth << ": " << c.first_difference;
       }
@@ -143,7 +140,7 @@ TEST(Packet, DepthLimitsAndDropsAsTheScalarTracer) {
   // is what test_extremes checks drop-free; here only agreement matters.
   Scene flat = small_scene("large_light.json", 16, 16);
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light"), flat);
-  for (PacketIsa isa : isas()) {
+  for (PacketIsa isa : available_packet_isas()) {
     const Comparison c = compare(isa, flat, plan, 4, SampleBlock{0, 0, 16, 16, 0, 4});
     EXPECT_LE(c.differing * 1000, c.samples) << c.first_difference;
   }
@@ -153,7 +150,7 @@ TEST(Packet, DepthLimitsAndDropsAsTheScalarTracer) {
 // the last; the tracer uses the widest unless PDFLAB_ISA names another. What
 // this machine ran is in the test's output (the bit comparisons above ran each).
 TEST(Packet, InstructionSetsAreListedWidestLast) {
-  const std::vector<PacketIsa> here = isas();
+  const std::vector<PacketIsa> here = available_packet_isas();
   ASSERT_FALSE(here.empty());
   EXPECT_EQ(here.front(), PacketIsa::Generic);
   for (std::size_t i = 1; i < here.size(); ++i)

@@ -57,14 +57,11 @@ DirectionSample one_path(const SamplingPlan& plan, const PlanDraw& d) {
   return to_direction_sample(leaf::sample_mixture(plan, at, chosen, true));
 }
 
-// Every instruction set this machine runs.
-std::vector<PacketIsa> isas() { return available_packet_isas(); }
-
 TEST(Techniques, PacketDrawsTheOnePathBits) {
   const std::vector<PlanDraw> in = draws(203, 1);  // not a multiple of the lanes
   for (const Strategy& strategy : strategies()) {
     const SamplingPlan plan = SamplingPlan::make(strategy, book());
-    for (const PacketIsa isa : isas()) {
+    for (const PacketIsa isa : available_packet_isas()) {
       std::vector<DirectionSample> packet(in.size());
       sample_plan(isa, plan, in.data(), in.size(), packet.data());
       std::vector<Vec3> directions;
