@@ -72,12 +72,7 @@ class Rng {
   float uniform() { return to_unit(next_u32()); }
 
   // The parts, for stepping many streams in SIMD lanes, and back.
-  static Rng from_parts(std::uint64_t state, std::uint64_t increment) {
-    Rng r(0, 0);
-    r.state_ = state;
-    r.increment_ = increment;
-    return r;
-  }
+  static Rng from_parts(std::uint64_t state, std::uint64_t increment) { return Rng(Parts{}, state, increment); }
   std::uint64_t state() const { return state_; }
   std::uint64_t increment() const { return increment_; }
   static std::uint32_t output(std::uint64_t old) {
@@ -93,6 +88,8 @@ class Rng {
   std::uint32_t qmc_index = 0, qmc_seed = 0;
 
  private:
+  struct Parts {};
+  Rng(Parts, std::uint64_t state, std::uint64_t increment) : increment_(increment), state_(state) {}
   std::uint64_t increment_;  // odd; selects the stream
   std::uint64_t state_;
 };
