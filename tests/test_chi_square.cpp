@@ -54,6 +54,7 @@ enum class Targets {
   Book,            // the book's scene: its light and its glass sphere
   TwoPowers,       // two emitting quads overhead, one 40x the other's power
   TwoLightsScene,  // assets/scenes/two_lights.json: a tiny bright light and a wide dim one
+  GlossyScene,     // assets/scenes/glossy_metal.json: a metal box (six quads) and a metal sphere
 };
 
 void add_quad_target(Scene& s, const Vec3& q, const Vec3& u, const Vec3& v) {
@@ -70,9 +71,15 @@ std::unique_ptr<Scene> make_scene(Targets which) {
     return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/cornell_book.json"));
   if (which == Targets::TwoLightsScene)
     return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/two_lights.json"));
+  if (which == Targets::GlossyScene)
+    return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/glossy_metal.json"));
   auto s = std::make_unique<Scene>();
   s->name = "chi-square targets";
-  s->materials.push_back(Material{});
+  // Metal, so that specular-objects aims at the same objects as light (a
+  // material changes no other technique's targets: they are marked).
+  Material metal;
+  metal.type = MaterialType::Metal;
+  s->materials.push_back(metal);
   s->material_names.push_back("m");
   switch (which) {
     case Targets::None: break;
@@ -104,7 +111,8 @@ std::unique_ptr<Scene> make_scene(Targets which) {
       break;
     }
     case Targets::Book:
-    case Targets::TwoLightsScene: break;
+    case Targets::TwoLightsScene:
+    case Targets::GlossyScene: break;
   }
   return s;
 }
@@ -197,6 +205,15 @@ const std::vector<ChiCase>& chi_cases() {
       {"mix_light_sa_025", "mix:cosine=0.75,light-sa=0.25", Targets::TwoDisjoint, {0, 0, 0}, {0, 1, 0}},
       {"mix_light_sa_05_grazing", "mix:cosine=0.5,light-sa=0.5", Targets::QuadUpright, {0, 0.3f, 0}, {0, 1, 0}},
       {"mix_light_and_light_sa", "mix:cosine=0.4,light=0.3,light-sa=0.3", Targets::TwoPowers, {0, 0, 0}, unit(0.2f, 1, 0)},
+      // specular-objects: the glass sphere of the book's scene; the metal box's
+      // six faces and the metal sphere of the glossy one.
+      {"specular_objects_book_from_floor", "specular-objects", Targets::Book, {400, 0, 150}, {0, 1, 0}},
+      // (From the back wall: from the floor, the box's bottom face lies in the
+      // shading point's plane, and its share of the samples along the horizon.)
+      {"specular_objects_glossy_from_back_wall", "specular-objects", Targets::GlossyScene, {278, 300, 555},
+       {0, 0, -1}},
+      {"specular_objects_glossy_from_red_wall", "mix:cosine=0.8,specular-objects=0.2", Targets::GlossyScene,
+       {0, 300, 300}, {1, 0, 0}},
       // The emitters that nee-mis samples (chosen by power, solid angle).
       {"nee_emitters_two_powers", "nee-mis", Targets::TwoPowers, {0, 0, 0}, {0, 1, 0}, true},
       {"nee_emitters_book", "nee-mis", Targets::Book, {400, 0, 150}, {0, 1, 0}, true},

@@ -198,7 +198,16 @@ std::vector<Point> target_outlines(const Scene& scene, const Vec3& origin, const
   std::vector<Point> out;
   const dvec3 o(origin);
   auto add = [&](const dvec3& dir) { out.push_back(frame.coordinates(Vec3(glm::normalize(dir)))); };
-  for (const Target& t : scene.targets) {
+  std::vector<Target> aimed_at = scene.targets;
+  const auto specular = [&](std::uint32_t material) {
+    const MaterialType type = scene.materials[material].type;
+    return type == MaterialType::Metal || type == MaterialType::Dielectric;
+  };
+  for (std::uint32_t i = 0; i < scene.quads.size(); ++i)
+    if (specular(scene.quads[i].material)) aimed_at.push_back({Target::Kind::Quad, i});
+  for (std::uint32_t i = 0; i < scene.spheres.size(); ++i)
+    if (specular(scene.spheres[i].material)) aimed_at.push_back({Target::Kind::Sphere, i});
+  for (const Target& t : aimed_at) {
     if (t.kind == Target::Kind::Quad) {
       const Quad& quad = scene.quads[t.index];
       const dvec3 q(quad.q), u(quad.u), v(quad.v);

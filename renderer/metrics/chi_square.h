@@ -45,8 +45,10 @@ struct Frame {
 using Density = std::function<double(const Vec3&)>;
 using Draw = std::function<DirectionSample(Rng&)>;
 
-// Points along every target's outline as seen from `origin`: the curves where
-// a light pdf jumps, spaced far closer than the quadrature's finest pieces.
+// Points along the outline of everything a technique aims at (the importance
+// targets, and the glass and metal objects of specular-objects) as seen from
+// `origin`: the curves where such a pdf jumps, spaced far closer than the
+// quadrature's finest pieces.
 std::vector<Point> target_outlines(const Scene& scene, const Vec3& origin, const Frame& frame);
 
 // The pdf integrated over each cell (probability, not counts), row-major.

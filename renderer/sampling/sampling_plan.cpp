@@ -11,20 +11,34 @@ namespace pdflab {
 
 namespace {
 
-// The strategy's weights, less those of techniques that aim at targets when
-// the scene has none (their weight goes to the others, renormalised by the
+// Whether technique T aims at targets of which the plan's scene has none.
+template <class T>
+bool aims_at_nothing(const SamplingPlan& plan) {
+  if constexpr (requires { T::targets(plan); }) return T::targets(plan).empty();
+  else return false;
+}
+
+// The strategy's weights, less those of techniques that aim at targets the
+// scene does not have (their weight goes to the others, renormalised by the
 // choice). Throws when no weight is left.
-std::array<double, kTechniqueCount> usable_weights(const Strategy& strategy, const Scene& scene, int target_count) {
+std::array<double, kTechniqueCount> usable_weights(const Strategy& strategy, const SamplingPlan& plan) {
   std::array<double, kTechniqueCount> w{};
   double total = 0.0;
-  for (int i = 0; i < kTechniqueCount; ++i) {
-    const bool aims_at_nothing = target_count == 0 && technique_info(static_cast<Technique>(i)).draws_target;
-    w[i] = aims_at_nothing ? 0.0 : strategy.weights[i];
-    total += w[i];
+  std::string missing;  // the techniques with weight that have nothing to aim at
+#define PDFLAB_ROW(T)                                                                  \
+  {                                                                                    \
+    const int i = static_cast<int>(Technique::T);                                      \
+    const bool nothing = aims_at_nothing<leaf::T>(plan);                               \
+    if (nothing && strategy.weights[i] > 0.0f)                                         \
+      missing.append(missing.empty() ? "" : ", ").append(technique_info(Technique::T).name); \
+    w[i] = nothing ? 0.0 : strategy.weights[i];                                        \
+    total += w[i];                                                                     \
   }
+  PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
   if (!(total > 0.0))
-    throw InputError("strategy '" + strategy.to_string() + "' samples only the importance targets, but scene '" +
-                     scene.name + "' has none");
+    throw InputError("strategy '" + strategy.to_string() + "' samples only targets (" + missing + "), but scene '" +
+                     plan.scene->name + "' has none");
   return w;
 }
 
@@ -55,12 +69,12 @@ void SamplingPlan::bind_targets() {
   book_targets = book_target_set(*scene);
   power_targets = power_target_set(*scene);
   emitters = emitter_set(*scene);
-  target_count = book_targets.size();
+  specular_objects = specular_object_set(*scene);
 }
 
 void SamplingPlan::set_technique_choice(const Strategy& strategy) {
   parameter = strategy.parameters;
-  const DiscreteDistribution choice = technique_choice(strategy, usable_weights(strategy, *scene, target_count));
+  const DiscreteDistribution choice = technique_choice(strategy, usable_weights(strategy, *this));
   for (int i = 0; i < kTechniqueCount; ++i) {
     weight[i] = choice.pmf(i);
     choice_threshold[i] = choice.thresholds()[static_cast<std::size_t>(i)];
@@ -69,6 +83,9 @@ void SamplingPlan::set_technique_choice(const Strategy& strategy) {
   int techniques = 0;
   for (int i = 0; i < kTechniqueCount; ++i) techniques += weight[i] > 0.0f ? 1 : 0;
   continuation_mixes = techniques > 1;
+  // nee-mis's continuation is cosine alone when that is all the weight the
+  // scene leaves it (fastest's specular-objects in a scene without glass or metal).
+  cosine_continuation = nee_mis && techniques == 1 && weight[static_cast<int>(Technique::Cosine)] > 0.0f;
 #define PDFLAB_ROW(T) \
   uses_frame = uses_frame || (leaf::uses_frame<leaf::T>() && weight[static_cast<int>(Technique::T)] > 0.0f);
   PDFLAB_TECHNIQUES(PDFLAB_ROW)
@@ -82,8 +99,6 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.heuristic = strategy.heuristic;
   plan.roulette_depth = strategy.roulette_depth;
   plan.sobol = strategy.sobol;
-  // nee-mis's continuation is a mixture like any other.
-  plan.cosine_continuation = strategy.nee_mis && strategy.cosine_continuation();
   plan.bind_targets();
   plan.set_technique_choice(strategy);
   return plan;

@@ -129,7 +129,7 @@ struct SamplingPlan {
   TargetSet book_targets;   // `light`: the importance targets, chosen uniformly
   TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
   TargetSet emitters;       // `nee-mis`: every emitter, by power
-  int target_count = 0;     // importance targets
+  TargetSet specular_objects;  // `specular-objects`: the glass and metal objects, chosen uniformly
 
   // Throws InputError when the strategy needs targets the scene does not have
   // and no other technique has weight, or when a positive weight is below

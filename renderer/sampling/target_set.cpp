@@ -108,19 +108,35 @@ bool is_importance_target(const Scene& scene, const Target& t) {
   return false;
 }
 
-bool is_emitter(const Scene& scene, const Target& t) {
+MaterialType material_type(const Scene& scene, const Target& t) {
   const std::uint32_t m = t.kind == Target::Kind::Quad ? scene.quads[t.index].material : scene.spheres[t.index].material;
-  return scene.materials[m].type == MaterialType::DiffuseLight;
+  return scene.materials[m].type;
+}
+
+bool is_emitter(const Scene& scene, const Target& t) { return material_type(scene, t) == MaterialType::DiffuseLight; }
+
+bool is_specular(const Scene& scene, const Target& t) {
+  const MaterialType type = material_type(scene, t);
+  return type == MaterialType::Metal || type == MaterialType::Dielectric;
+}
+
+// Every object `pick` accepts, chosen uniformly, quads by area.
+template <class Pick>
+TargetSet uniform_area_set(const Scene& scene, Pick pick) {
+  TargetSet set;
+  const std::size_t n = collect_targets(scene, set, pick).size();
+  set.set_probabilities(std::vector<double>(n, 1.0));
+  return set;
 }
 
 }  // namespace
 
 TargetSet book_target_set(const Scene& scene) {
-  TargetSet set;
-  const std::size_t n =
-      collect_targets(scene, set, [&](const Target& t) { return is_importance_target(scene, t); }).size();
-  set.set_probabilities(std::vector<double>(n, 1.0));
-  return set;
+  return uniform_area_set(scene, [&](const Target& t) { return is_importance_target(scene, t); });
+}
+
+TargetSet specular_object_set(const Scene& scene) {
+  return uniform_area_set(scene, [&](const Target& t) { return is_specular(scene, t); });
 }
 
 TargetSet power_target_set(const Scene& scene) {

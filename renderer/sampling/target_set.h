@@ -60,6 +60,10 @@ TargetSet book_target_set(const Scene& scene);
 TargetSet power_target_set(const Scene& scene);
 // nee-mis's: every emitter of the scene by solid angle, chosen by power.
 TargetSet emitter_set(const Scene& scene);
+// `specular-objects`'s: every quad and sphere of glass or metal, chosen
+// uniformly, quads by area (what carries caustics and light seen in mirrors,
+// which a light sample cannot reach through).
+TargetSet specular_object_set(const Scene& scene);
 
 // How much light an emitter sends out (luminance of emit * area * pi, doubled
 // when two-sided): the weight for choosing it in proportion to its power.

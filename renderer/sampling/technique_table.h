@@ -14,6 +14,7 @@
 #include "renderer/sampling/techniques/light.inc"
 #include "renderer/sampling/techniques/light_solid_angle.inc"
 #include "renderer/sampling/techniques/cosine_power.inc"
+#include "renderer/sampling/techniques/specular_objects.inc"
 
 #elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
 #define PDFLAB_TECHNIQUE_TABLE_H
@@ -25,7 +26,8 @@
   X(UniformSphere)           \
   X(Light)                   \
   X(LightSolidAngle)         \
-  X(CosinePower)
+  X(CosinePower)             \
+  X(SpecularObjects)
 
 #include <array>
 #include <cstdint>
