@@ -71,6 +71,9 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"nee-mis+mix:cosine=0.5,light=0.5", 256},
       {"nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr", 256},
       {"fastest", 256},
+      // Continuations aimed at the glass sphere as a glass object (specular-objects).
+      {"mix:cosine=0.75,specular-objects=0.25", 512},
+      {"nee-mis+mix:cosine=0.8,specular-objects=0.2+rr", 256},
       // The +sobol sampler's stratified draws.
       {"mix:cosine=0.5,light=0.5+sobol", 512},
       {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256},
@@ -217,7 +220,9 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
                       {"nee-mis:balance", 128, false},
                       {"mix:cosine=0.5,light-sa=0.5+rr", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5", 128, false},
-                      {"fastest", 128, false},  // today nee-mis+sobol+rr:5: nee-mis's spp
+                      {"fastest", 128, false},  // nee-mis continued by cosine and specular-objects: nee-mis's spp
+                      {"mix:cosine=0.75,specular-objects=0.25", 256, true},  // cosine where there is no metal
+                      {"nee-mis+mix:cosine=0.7,specular-objects=0.3+rr", 128, false},
                       {"mix:cosine=0.5,light=0.5+sobol", 256, false},
                       {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256, false}};  // today the book mixture: its spp
   constexpr int kSmall = 24;

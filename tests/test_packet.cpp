@@ -40,7 +40,10 @@ const char* const kStrategies[] = {"cosine",
                                    "mix:cosine=0.5,light=0.5+sobol",
                                    "nee-mis+sobol",
                                    "nee-mis+mix:cosine=0.5,light=0.5+sobol+rr:1",
-                                   "light-sa+sobol"};
+                                   "light-sa+sobol",
+                                   "mix:cosine=0.6,specular-objects=0.4",
+                                   "nee-mis+mix:cosine=0.8,specular-objects=0.2+sobol+rr:3",
+                                   "nee-mis+mix:cosine=0.4,light=0.3,specular-objects=0.3"};
 
 Scene small_scene(const std::string& file, int width, int height) {
   Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);
