@@ -9,6 +9,7 @@
 #include "renderer/sampling/strategy.h"
 #include "renderer/sampling/techniques.h"
 #include "renderer/scene/scene.h"
+#include "renderer/scene/scene_loader.h"
 
 #include <gtest/gtest.h>
 #include <pcg_random.hpp>
@@ -310,6 +311,47 @@ TEST(StrategyParse, ContinuationsRouletteAndFastest) {
   expect_rejected("nee-mis+", {"mixture is empty"});
   expect_rejected("nee-mis+nee-mis", {"cannot be mixed"});
   expect_rejected("nee-mis:fast+cosine", {"'power' or 'balance'"});
+}
+
+// specular-objects aims at the glass and metal objects, found by material;
+// where a scene has none it gets no weight, and fastest's continuation is
+// then cosine alone (the bits of nee-mis+sobol+rr:5); alone there it is refused.
+TEST(SamplingPlan, SpecularObjectsAreTheGlassAndMetalObjects) {
+  const auto scene = [](const char* file) {
+    return load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);
+  };
+  const Strategy fastest = Strategy::parse("fastest");
+  const int spec = static_cast<int>(Technique::SpecularObjects), cos = static_cast<int>(Technique::Cosine);
+
+  const Scene book = scene("cornell_book.json");  // the glass sphere
+  const SamplingPlan in_book = SamplingPlan::make(fastest, book);
+  ASSERT_EQ(in_book.specular_objects.spheres.size(), 1u);
+  EXPECT_TRUE(in_book.specular_objects.quads.empty());
+  EXPECT_EQ(book.materials[in_book.specular_objects.spheres[0].sphere->material].type, MaterialType::Dielectric);
+  EXPECT_NEAR(in_book.weight[spec], 0.2f, 1e-6f);
+  EXPECT_FALSE(in_book.cosine_continuation);
+  EXPECT_TRUE(in_book.continuation_mixes);
+
+  const Scene glossy = scene("glossy_metal.json");  // a metal box (six faces) and a metal sphere, none marked
+  const SamplingPlan in_glossy = SamplingPlan::make(fastest, glossy);
+  EXPECT_EQ(in_glossy.specular_objects.quads.size(), 6u);
+  EXPECT_EQ(in_glossy.specular_objects.spheres.size(), 1u);
+  for (const auto& q : in_glossy.specular_objects.quads) EXPECT_NEAR(q.probability, 1.0f / 7.0f, 1e-6f);
+
+  const Scene small = scene("small_light.json");  // no glass, no metal
+  const SamplingPlan in_small = SamplingPlan::make(fastest, small);
+  EXPECT_TRUE(in_small.specular_objects.empty());
+  EXPECT_EQ(in_small.weight[spec], 0.0f);
+  EXPECT_EQ(in_small.weight[cos], 1.0f);
+  EXPECT_TRUE(in_small.cosine_continuation);
+  EXPECT_FALSE(in_small.continuation_mixes);
+  try {
+    SamplingPlan::make(Strategy::parse("specular-objects"), small);
+    ADD_FAILURE() << "specular-objects alone in a scene without glass or metal was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("specular-objects"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("has none"), std::string::npos) << e.what();
+  }
 }
 
 TEST(StrategyParse, Rejections) {
