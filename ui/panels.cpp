@@ -259,9 +259,25 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
   bool any = strategy.nee_mis;
   for (float w : strategy.weights) any = any || w > 0.0f;
   if (any) {
-    ImGui::TextUnformatted(strategy.to_string().c_str());
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
-    ImGui::SameLine();
+    // Wrapped before a '+' where it is wider than the panel (fastest's is), never
+    // inside a weight; the bias label after it, on the next line if it does not fit.
+    const std::string text = strategy.to_string();
+    const float line_end = ImGui::GetCursorScreenPos().x + ImGui::GetContentRegionAvail().x;
+    const auto same_line_if_fits = [&](const char* next, float spacing) {
+      ImGui::SameLine(0.0f, spacing);
+      if (ImGui::GetCursorScreenPos().x + ImGui::CalcTextSize(next).x > line_end) ImGui::NewLine();
+    };
+    bool hovered = false;
+    for (std::size_t begin = 0; begin < text.size();) {
+      const std::size_t end = std::min(text.find('+', begin + 1), text.size());
+      const std::string piece = text.substr(begin, end - begin);
+      if (begin > 0) same_line_if_fits(piece.c_str(), 0.0f);
+      ImGui::TextUnformatted(piece.c_str());
+      hovered = hovered || ImGui::IsItemHovered();
+      begin = end;
+    }
+    if (hovered) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
+    same_line_if_fits(strategy.is_unbiased() ? "unbiased" : "BIASED", ImGui::GetStyle().ItemSpacing.x);
     if (strategy.is_unbiased()) {
       ImGui::TextColored(kGreen, "unbiased");
     } else {
