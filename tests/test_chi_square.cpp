@@ -4,6 +4,7 @@
 // one-path tracer's and the packet kernel's, which renders.
 #include "renderer/metrics/chi_square.h"
 #include "renderer/metrics/statistics.h"
+#include "renderer/sampling/leaf.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/sampling/techniques.h"
@@ -214,9 +215,13 @@ const std::vector<ChiCase>& chi_cases() {
        {0, 0, -1}},
       {"specular_objects_glossy_from_red_wall", "mix:cosine=0.8,specular-objects=0.2", Targets::GlossyScene,
        {0, 300, 300}, {1, 0, 0}},
-      // The emitters that nee-mis samples (chosen by power, solid angle).
+      // The emitters that nee-mis samples (chosen by power; by area from where a
+      // light looks flat, else in solid angle): both flat, both not, one of each.
       {"nee_emitters_two_powers", "nee-mis", Targets::TwoPowers, {0, 0, 0}, {0, 1, 0}, true},
       {"nee_emitters_book", "nee-mis", Targets::Book, {400, 0, 150}, {0, 1, 0}, true},
+      {"nee_emitters_two_powers_close", "nee-mis", Targets::TwoPowers, {0, 0.9f, 0}, {0, 1, 0}, true},
+      {"nee_emitters_two_powers_one_flat", "nee-mis", Targets::TwoPowers, {-0.9f, 0.8f, 0}, {0, 1, 0}, true},
+      {"nee_emitters_book_close_to_the_light", "nee-mis", Targets::Book, {300, 500, 250}, {0, 1, 0}, true},
   };
   return cases;
 }
@@ -364,6 +369,25 @@ INSTANTIATE_TEST_SUITE_P(Techniques, ChiSquare, ::testing::Range(0, static_cast<
                          });
 
 // ---- The test itself has power: wrong pdfs are rejected ------------------
+
+// The nee_emitters cases reach both of nee-mis's light samplers: which of
+// the emitters each origin samples by area (leaf::area_suffices), by name.
+TEST(ChiSquareCases, NeeEmitterCasesReachBothSamplers) {
+  const std::pair<const char*, std::vector<bool>> expected[] = {
+      {"nee_emitters_two_powers", {true, true}},         {"nee_emitters_book", {true}},
+      {"nee_emitters_two_powers_close", {false, false}}, {"nee_emitters_two_powers_one_flat", {false, true}},
+      {"nee_emitters_book_close_to_the_light", {false}},
+  };
+  for (const auto& [name, by_area] : expected) {
+    const auto c = std::find_if(every_case().begin(), every_case().end(),
+                                [&](const ChiCase& x) { return std::string(x.name) == name; });
+    ASSERT_NE(c, every_case().end()) << name;
+    const PlanUnderTest p = bind(*c);
+    ASSERT_EQ(p.plan.emitters.quads.size(), by_area.size()) << name;
+    for (std::size_t i = 0; i < by_area.size(); ++i)
+      EXPECT_EQ(leaf::area_suffices(p.plan.emitters.quads[i].axes, p.origin), by_area[i]) << name << " emitter " << i;
+  }
+}
 
 TEST(ChiSquareHarness, RejectsCosineSamplesAgainstUniformPdf) {
   const Vec3 n(0, 0, 1);

@@ -3,6 +3,7 @@
 // huge and distant lights, large coordinates; and no dropped samples on any
 // shipped scene.
 #include "renderer/error.h"
+#include "renderer/sampling/target_set.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
 
@@ -191,7 +192,7 @@ TEST(Extremes, FloatSphericalRectangleAgreesWithTheDoubleForm) {
       const Vec3 origin(reach * (rng.uniform() - 0.5f), reach * (rng.uniform() - 0.5f), reach * (rng.uniform() - 0.5f));
       const SphericalRectangle d = spherical_rectangle(q, origin);
       const RectangleAxes axes = rectangle_axes(q);
-      const leaf::SphericalRectangle f = leaf::spherical_rectangle(axes, origin);
+      const leaf::SphericalRectangle f = leaf::spherical_rectangle(axes, origin, true);
       ++total;
       if (!f.fast) continue;
       ++fast;
@@ -214,6 +215,63 @@ TEST(Extremes, FloatSphericalRectangleAgreesWithTheDoubleForm) {
   std::printf("float set-up: %d of %d rectangles, worst solid angle error %.2g, worst point error %.2g of the extent\n",
               fast, total, worst_s, worst_point);
   EXPECT_GT(fast, total / 3);  // the float form is the common case
+}
+
+// nee-mis samples a light by area from where it looks flat (its farthest point
+// at most kEmitterFlatDistanceRatio times as far as its nearest): the test's
+// nearest and farthest distances are the true extremes over the rectangle
+// (checked against a fine grid of its points), behind a one-sided light it is
+// always true, and over the rectangle itself (nearest distance 0) never.
+TEST(Extremes, AreaSamplingFromWhereALightLooksFlat) {
+  Rng rng(41, 3);
+  int flat = 0, curved = 0;
+  for (int i = 0; i < 400; ++i) {
+    const float w = 0.2f + 2.0f * rng.uniform(), h = 0.2f + 2.0f * rng.uniform(), turn = 6.2831853f * rng.uniform();
+    const Vec3 corner(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f);
+    const Quad q = make_quad(corner, Vec3(w * std::cos(turn), 0.0f, w * std::sin(turn)),
+                             Vec3(-h * std::sin(turn) * 0.6f, h * 0.8f, h * std::cos(turn) * 0.6f), 0);
+    RectangleAxes axes = rectangle_axes(q);
+    axes.flat_distance_ratio = kEmitterFlatDistanceRatio;
+    const float reach = i % 3 == 0 ? 30.0f : 4.0f;
+    const Vec3 origin(reach * (rng.uniform() - 0.5f), reach * (rng.uniform() - 0.5f), reach * (rng.uniform() - 0.5f));
+    double nearest = 1e30, farthest = 0.0;
+    const int n = 200;
+    for (int a = 0; a <= n; ++a)
+      for (int b = 0; b <= n; ++b) {
+        const Vec3 p = q.q + q.u * (static_cast<float>(a) / n) + q.v * (static_cast<float>(b) / n);
+        const double d = static_cast<double>(length(p - origin));
+        nearest = std::min(nearest, d), farthest = std::max(farthest, d);
+      }
+    const double ratio = farthest / nearest;
+    const bool expected = ratio <= kEmitterFlatDistanceRatio;
+    // A grid's nearest point may lie a little farther than the true nearest:
+    // judge only where the ratio is clear of the bound.
+    if (std::fabs(ratio / kEmitterFlatDistanceRatio - 1.0) > 0.02) {
+      EXPECT_EQ(leaf::area_suffices(axes, origin), expected) << i << " distance ratio " << ratio;
+    }
+    (expected ? flat : curved) += 1;
+    axes.flat_distance_ratio = 0.0f;  // never, but for the one-sided rule
+    EXPECT_FALSE(leaf::area_suffices(axes, origin));
+  }
+  EXPECT_GT(flat, 50);
+  EXPECT_GT(curved, 50);
+
+  // The book's light (one-sided, facing down): from behind, always; from the
+  // floor below it, flat; from 24 units under it, not; in its plane over it, not.
+  const Quad light = make_quad(Vec3(213, 554, 227), Vec3(130, 0, 0), Vec3(0, 0, 105), 0);
+  RectangleAxes axes = rectangle_axes(light);
+  axes.one_sided = true;
+  axes.flat_distance_ratio = kEmitterFlatDistanceRatio;
+  EXPECT_TRUE(leaf::area_suffices(axes, Vec3(278, 554.9f, 279)));
+  EXPECT_TRUE(leaf::area_suffices(axes, Vec3(278, 0, 279)));
+  EXPECT_FALSE(leaf::area_suffices(axes, Vec3(278, 530, 279)));
+  axes.one_sided = false;
+  EXPECT_FALSE(leaf::area_suffices(axes, Vec3(278, 554, 279)));
+  EXPECT_FALSE(leaf::area_suffices(axes, Vec3(278, 554.9f, 279)));
+  // Where every lane is sampled by area nothing is set up, and the result says so.
+  const leaf::SphericalRectangle r = leaf::spherical_rectangle(axes, Vec3(278, 0, 279), true);
+  EXPECT_TRUE(r.area);
+  EXPECT_FALSE(r.fast);
 }
 
 TEST(Extremes, TinyLightFallsBackToAreaSamplingConsistently) {

@@ -78,7 +78,8 @@ bool roulette_survives(const SamplingPlan& plan, int depth, Vec3& throughput, co
 }
 
 // Next-event estimation with MIS: at each diffuse vertex one light sample
-// (shadow ray, solid-angle sampling of the emitters chosen by power) and one
+// (shadow ray; the emitters chosen by power, in solid angle or by area where a
+// light looks flat: emitter_set) and one
 // sample of the plan's mixture (cosine alone for plain nee-mis) that continues
 // the path. Emission reached by the continuation is weighted against the light
 // technique's density for the same direction, and the light sample against the

@@ -28,6 +28,12 @@ struct RectangleAxes {
   // its light cannot reach the point, so it is sampled there by area, the
   // cheapest valid density (what it aims at is worth nothing from there).
   bool one_sided = false;
+  // Sampled by area from a point whose distances to the rectangle's points
+  // differ by at most this factor (leaf::area_suffices; 0: never): the area
+  // density, in solid angle, then varies by at most its cube, and is within
+  // that of uniform, at a fraction of the spherical rectangle's cost.
+  float flat_distance_ratio = 0.0f;
+  Vec3 corner{0.0f};  // quad.q in float, for that test
 };
 
 namespace leaf {

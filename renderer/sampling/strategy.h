@@ -56,8 +56,9 @@ struct Strategy {
   // Each technique's parameter (TechniqueInfo::parameter; `cosine-power:8`),
   // its default where the technique has one, else 0.
   std::array<float, kTechniqueCount> parameters = default_parameters();
-  // Next-event estimation: at each diffuse vertex one light sample (shadow ray,
-  // solid-angle sampling of the emitters chosen by power) and one sample of
+  // Next-event estimation: at each diffuse vertex one light sample (shadow ray;
+  // the emitters chosen by power, each sampled in solid angle or, where it
+  // looks flat, by area: emitter_set) and one sample of
   // `weights` that continues the path, combined with multiple importance
   // sampling.
   bool nee_mis = false;

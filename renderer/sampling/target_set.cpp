@@ -151,6 +151,7 @@ TargetSet power_target_set(const Scene& scene) {
 TargetSet emitter_set(const Scene& scene) {
   TargetSet set;
   const std::vector<double> power = collect_targets(scene, set, [&](const Target& t) { return is_emitter(scene, t); });
+  for (TargetSet::QuadEntry& e : set.quads) e.axes.flat_distance_ratio = kEmitterFlatDistanceRatio;
   set.solid_angle = true;
   set.set_probabilities(power_weights(power));
   return set;

@@ -58,7 +58,16 @@ TargetSet book_target_set(const Scene& scene);
 // `light-sa`'s: the importance targets by solid angle, chosen in proportion to
 // their power (a target that emits nothing gets the mean emitter's share).
 TargetSet power_target_set(const Scene& scene);
-// nee-mis's: every emitter of the scene by solid angle, chosen by power.
+// nee-mis's: every emitter of the scene by solid angle, chosen by power, except
+// where a rectangle looks flat: from a point whose distances to the light's
+// points differ by at most kEmitterFlatDistanceRatio it is sampled by area
+// (RectangleAxes::flat_distance_ratio), whose density is then within the cube
+// of that ratio of uniform in solid angle. Measured (README): on the book's box
+// the same error as solid angle everywhere at 28% less time a sample; a small
+// light is flat from everywhere, and sampled by area in a third of the time its
+// spherical rectangle took (below float's domain, it took the double form); the
+// large light loses 8% (its floor sees it flat, where solid angle did better).
+inline constexpr float kEmitterFlatDistanceRatio = 2.0f;
 TargetSet emitter_set(const Scene& scene);
 // `specular-objects`'s: every quad and sphere of glass or metal, chosen
 // uniformly, quads by area (what carries caustics and light seen in mirrors,

@@ -69,6 +69,7 @@ RectangleAxes rectangle_axes(const Quad& quad) {
   a.y = Vec3(static_cast<float>(y.x), static_cast<float>(y.y), static_cast<float>(y.z));
   a.z = Vec3(static_cast<float>(z.x), static_cast<float>(z.y), static_cast<float>(z.z));
   a.ex = static_cast<float>(ex), a.ey = static_cast<float>(ey);
+  a.corner = quad.q;
   return a;
 }
 
