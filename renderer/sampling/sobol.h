@@ -18,6 +18,7 @@
 // one-path tracer, a vector of uint32 lanes (GCC vector extensions) for the
 // packet tracer, so both compute the same bits with the same code.
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 // Always inlined, so that in the packet tracer they compile inside its
@@ -34,13 +35,15 @@ namespace pdflab::qmc {
 // samples are stratified in full is kIndexBits, below).
 inline constexpr int kBits = 32;
 
+// Each step swaps neighbouring groups of bits as a bitwise select of the word
+// shifted down and up (one AVX-512 ternary-logic instruction after the shifts).
 template <class U>
 PDFLAB_QMC constexpr U reverse_bits(const U& bits) {
   U v = bits;
-  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
-  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
-  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
-  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+  v = ((v >> 1) & 0x55555555u) | ((v << 1) & 0xaaaaaaaau);
+  v = ((v >> 2) & 0x33333333u) | ((v << 2) & 0xccccccccu);
+  v = ((v >> 4) & 0x0f0f0f0fu) | ((v << 4) & 0xf0f0f0f0u);
+  v = ((v >> 8) & 0x00ff00ffu) | ((v << 8) & 0xff00ff00u);
   return (v >> 16) | (v << 16);
 }
 
@@ -129,13 +132,60 @@ constexpr ReversedDirections make_reversed_directions() {
 }
 inline constexpr ReversedDirections kReversedDirections = make_reversed_directions();
 
+// The same product four bits of the index at a time: chunk k of the index
+// selects the XOR of columns 4k to 4k + 3 that its bits name, from a table of
+// sixteen.
+inline constexpr int kChunks = kIndexBits / 4;
+struct ChunkTables {
+  std::uint32_t xor_of[2][kChunks][16]{};
+};
+constexpr ChunkTables make_chunk_tables() {
+  ChunkTables t;
+  for (int d = 0; d < 2; ++d)
+    for (int k = 0; k < kChunks; ++k)
+      for (std::uint32_t bits = 0; bits < 16; ++bits)
+        for (int b = 0; b < 4; ++b)
+          if ((bits >> b) & 1u) t.xor_of[d][k][bits] ^= kReversedDirections.column[d][4 * k + b];
+  return t;
+}
+inline constexpr ChunkTables kChunkTables = make_chunk_tables();
+
 template <class U>
 PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
   if (dim == 0) return index;  // van der Corput is the reversal itself
-  const std::uint32_t* column = kReversedDirections.column[dim - 1];
-  U result = index ^ index;  // zero, of U's type
-  for (int k = 0; k < kIndexBits; ++k) result ^= column[k] & (0u - ((index >> k) & 1u));
-  return result;
+  const auto& table = kChunkTables.xor_of[dim - 1];
+  if constexpr (std::is_integral_v<U>) {
+    U result = 0;
+    for (int k = 0; k < kChunks; ++k) result ^= table[k][(index >> (4 * k)) & 15u];
+    return result;
+  } else {
+    U result = index ^ index;  // zero, of U's type
+    constexpr int lanes = static_cast<int>(sizeof(U) / sizeof(std::uint32_t));
+#if defined(__GNUC__) && !defined(__clang__)
+    if constexpr (lanes == 8 || lanes == 16) {
+      // A table of sixteen is one vector of sixteen lanes, or two of eight:
+      // one lane-wise look-up (a permute) a chunk.
+      for (int k = 0; k < kChunks; ++k) {
+        const U chunk = (index >> (4 * k)) & 15u;
+        if constexpr (lanes == 16) {
+          U t;
+          std::memcpy(&t, table[k], sizeof t);
+          result ^= __builtin_shuffle(t, chunk);
+        } else {
+          U low, high;
+          std::memcpy(&low, table[k], sizeof low);
+          std::memcpy(&high, table[k] + lanes, sizeof high);
+          result ^= __builtin_shuffle(low, high, chunk);
+        }
+      }
+      return result;
+    }
+#endif
+    // Narrower vectors (and clang, which has no look-up by lane): bit by bit.
+    const std::uint32_t* column = kReversedDirections.column[dim - 1];
+    for (int k = 0; k < kIndexBits; ++k) result ^= column[k] & (0u - ((index >> k) & 1u));
+    return result;
+  }
 }
 
 // What each draw group of a vertex is, for its seed.
