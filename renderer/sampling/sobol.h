@@ -160,8 +160,8 @@ PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
     return result;
   } else {
     U result = index ^ index;  // zero, of U's type
-    constexpr int lanes = static_cast<int>(sizeof(U) / sizeof(std::uint32_t));
 #if defined(__GNUC__) && !defined(__clang__)
+    constexpr int lanes = static_cast<int>(sizeof(U) / sizeof(std::uint32_t));
     if constexpr (lanes == 8 || lanes == 16) {
       // A table of sixteen is one vector of sixteen lanes, or two of eight:
       // one lane-wise look-up (a permute) a chunk.
