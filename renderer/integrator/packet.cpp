@@ -16,10 +16,12 @@
 #if defined(__x86_64__) || defined(__i386__)
 // GCC 12 warns inside its own AVX-512 header, where _mm512_undefined_ps and
 // its kin read a deliberately undefined register (GCC bug 105593): the
-// warning is about the header's lines, so it is turned off for them only.
+// warnings (maybe and definitely uninitialized, by how the call is inlined)
+// are about the header's lines, so they are turned off for them only.
 #pragma GCC diagnostic push
 #if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #endif
 #include <immintrin.h>
 #pragma GCC diagnostic pop
