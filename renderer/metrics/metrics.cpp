@@ -117,6 +117,49 @@ double mean_relative_standard_error(const Film& film, double epsilon) {
   return noise_summary(film, map, epsilon).mean_relative_standard_error;
 }
 
+void NoiseSums::add(const NoiseSums& other) {
+  relative_standard_error += other.relative_standard_error;
+  relative_variance += other.relative_variance;
+  pixels += other.pixels;
+}
+
+NoiseSummary NoiseSums::summary() const {
+  NoiseSummary out;
+  if (pixels) {
+    out.mean_relative_standard_error = relative_standard_error / static_cast<double>(pixels);
+    out.estimated_relmse = relative_variance / (3.0 * static_cast<double>(pixels));
+  }
+  return out;
+}
+
+NoiseSums sweep_noise_rect(const Film& film, int x0, int y0, int x1, int y1, double epsilon, float* map,
+                           float* mean_rgb) {
+  NoiseSums sums;
+  std::uint32_t count = 0;  // after a full pass every pixel has the same count
+  Film::Reciprocals r = Film::reciprocals(count);
+  const auto width = static_cast<std::size_t>(film.width());
+  for (int y = y0; y < y1; ++y)
+  for (std::size_t p = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x0),
+                   end = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x1);
+       p < end; ++p) {
+    if (film.count(p) != count) r = Film::reciprocals(count = film.count(p));
+    double m[3], v[3];
+    film.moments(p, r, m, v);
+    if (mean_rgb)
+      for (int c = 0; c < 3; ++c) mean_rgb[3 * p + c] = static_cast<float>(m[c]);
+    if (count < 2) {
+      if (map) map[p] = 0.0f;
+      continue;
+    }
+    const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
+    if (map) map[p] = static_cast<float>(rse);
+    sums.relative_standard_error += rse;
+    for (int c = 0; c < 3; ++c) sums.relative_variance += v[c] / (m[c] * m[c] + epsilon);
+    ++sums.pixels;
+  }
+  return sums;
+}
+
 namespace {
 
 // The sweep behind noise_summary; `map` and `mean_rgb` may be null (then no
@@ -125,32 +168,9 @@ NoiseSummary sweep_noise(const Film& film, std::vector<float>* map, double epsil
   const std::size_t pixels = film.pixel_count();
   if (map) map->resize(pixels);  // every pixel is written below
   if (mean_rgb) mean_rgb->resize(3 * pixels);
-  double rse_sum = 0.0, rel_sum = 0.0;
-  std::size_t n = 0;
-  std::uint32_t count = 0;  // after a full pass every pixel has the same count
-  Film::Reciprocals r = Film::reciprocals(count);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    if (film.count(p) != count) r = Film::reciprocals(count = film.count(p));
-    double m[3], v[3];
-    film.moments(p, r, m, v);
-    if (mean_rgb)
-      for (int c = 0; c < 3; ++c) (*mean_rgb)[3 * p + c] = static_cast<float>(m[c]);
-    if (count < 2) {
-      if (map) (*map)[p] = 0.0f;
-      continue;
-    }
-    const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
-    if (map) (*map)[p] = static_cast<float>(rse);
-    rse_sum += rse;
-    for (int c = 0; c < 3; ++c) rel_sum += v[c] / (m[c] * m[c] + epsilon);
-    ++n;
-  }
-  NoiseSummary out;
-  if (n) {
-    out.mean_relative_standard_error = rse_sum / static_cast<double>(n);
-    out.estimated_relmse = rel_sum / (3.0 * static_cast<double>(n));
-  }
-  return out;
+  return sweep_noise_rect(film, 0, 0, film.width(), film.height(), epsilon, map ? map->data() : nullptr,
+                          mean_rgb ? mean_rgb->data() : nullptr)
+      .summary();
 }
 
 }  // namespace

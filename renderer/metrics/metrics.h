@@ -98,4 +98,20 @@ struct NoiseSummary {
 NoiseSummary noise_summary(const Film& film, std::vector<float>& map, double epsilon = kRelMseEpsilon,
                            std::vector<float>* mean_rgb = nullptr);
 
+// The sweep's running sums over some of the pixels: sweeps of disjoint parts,
+// added in a fixed order, make the summary of their union (a render session
+// sweeps each tile as soon as a pass has rendered it, on the worker that did).
+struct NoiseSums {
+  double relative_standard_error = 0.0;  // sum over the pixels with two samples or more
+  double relative_variance = 0.0;        // sum over those pixels and the three channels
+  std::size_t pixels = 0;
+  void add(const NoiseSums& other);
+  NoiseSummary summary() const;
+};
+// The pixels of rows [y0, y1) and columns [x0, x1) of the film: their sums;
+// where given, their entries of a map and a mean image that cover the whole
+// film (indexed by pixel, as above).
+NoiseSums sweep_noise_rect(const Film& film, int x0, int y0, int x1, int y1, double epsilon, float* map,
+                           float* mean_rgb);
+
 }  // namespace pdflab

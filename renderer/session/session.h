@@ -202,6 +202,10 @@ class RenderSession {
   double full_samples_per_second_ = 0.0;  // measured on full passes, sizes the preview
   std::vector<float> preview_;        // preview pixels, written by workers (disjoint)
   NoiseSummary noise_;                // of the last full pass
+  // Each tile's noise sums in the open full pass, written by the worker that
+  // rendered the tile as soon as it has (disjoint slots), added in tile order
+  // when the pass ends.
+  std::vector<NoiseSums> tile_noise_;
 
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<int> next_tile_{0};
@@ -216,8 +220,10 @@ class RenderSession {
   ImageInfo image_info_;
   std::vector<float> image_rse_;            // published with image_, empty for a preview
   std::vector<std::uint8_t> image_drops_;
-  // Filled under mutex_, then swapped with the published ones: the buffers of
-  // the pass before are reused, not allocated (and faulted in) again.
+  // Filled during a pass (each tile's pixels by the worker that rendered it,
+  // a preview's by the last worker out), then swapped with the published ones
+  // under mutex_: the buffers of the pass before are reused, not allocated
+  // (and faulted in) again.
   std::vector<float> spare_rgb_;
   std::vector<float> spare_rse_;
   std::vector<std::uint8_t> spare_drops_;
