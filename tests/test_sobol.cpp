@@ -88,7 +88,8 @@ TEST(Sobol, UnscrambledDimensionsAreSobolsAndNets) {
 
 // The packet tracer's vectors of 4, 8 and 16 lanes (each computed its own way:
 // bit by bit, or by lane-wise look-ups in one or two vectors) give the one-path
-// tracer's bits, lane by lane.
+// tracer's bits, lane by lane: the points, their 16-bit products and the
+// unscrambled 32-bit ones.
 typedef std::uint32_t Lanes4 __attribute__((vector_size(16)));
 typedef std::uint32_t Lanes8 __attribute__((vector_size(32)));
 typedef std::uint32_t Lanes16 __attribute__((vector_size(64)));
@@ -103,9 +104,11 @@ void expect_vector_points_match() {
       const qmc::Point<UV> p = qmc::point(index, block_seed, 3);
       for (int d = 0; d < 3; ++d) {
         const UV r = qmc::sobol_reversed(index & 0xffffu, d), b = qmc::reverse_bits(index);
+        const UV u = qmc::sobol(index * 40503u, d);  // all 32 bits (the pixel jitter's)
         for (int l = 0; l < Lanes; ++l) {
           ASSERT_EQ(p.dim[d][l], qmc::point(index[l], block_seed[l], 3).dim[d]) << Lanes << " lanes, " << index[l];
           ASSERT_EQ(r[l], qmc::sobol_reversed(index[l] & 0xffffu, d));
+          ASSERT_EQ(u[l], qmc::sobol(index[l] * 40503u, d));
           ASSERT_EQ(b[l], qmc::reverse_bits(index[l]));
         }
       }

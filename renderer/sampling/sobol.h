@@ -68,21 +68,6 @@ constexpr Directions make_directions() {
 }
 inline constexpr Directions kDirections = make_directions();
 
-// Sobol dimension `dim` (0, 1 or 2) of point `index`, unscrambled, as 32 bits.
-template <class U>
-PDFLAB_QMC U sobol(const U& index, int dim) {
-  if (dim == 0) return reverse_bits(index);
-  const std::uint32_t* column = kDirections.column[dim - 1];
-  U result = index ^ index;  // zero, of U's type
-  for (int k = 0; k < kBits; ++k) {
-    if constexpr (std::is_integral_v<U>) {
-      if ((index >> k) == 0u) break;  // no higher bit set
-    }
-    result ^= column[k] & (0u - ((index >> k) & 1u));  // no branch on the bit
-  }
-  return result;
-}
-
 // A 32-bit integer hash (a two-multiply xorshift finaliser), for seeds.
 template <class U>
 PDFLAB_QMC U hash(const U& value) {
@@ -132,31 +117,35 @@ constexpr ReversedDirections make_reversed_directions() {
 }
 inline constexpr ReversedDirections kReversedDirections = make_reversed_directions();
 
-// The same product four bits of the index at a time: chunk k of the index
-// selects the XOR of columns 4k to 4k + 3 that its bits name, from a table of
-// sixteen.
-inline constexpr int kChunks = kIndexBits / 4;
+// A product by a generator matrix over GF(2) (the XOR of the columns that the
+// index's set bits name), four index bits at a time: chunk k of the index
+// selects, from a table of sixteen, the XOR of columns 4k to 4k + 3 that its
+// bits name.
+template <int Columns>
 struct ChunkTables {
-  std::uint32_t xor_of[2][kChunks][16]{};
+  static constexpr int kChunks = Columns / 4;
+  std::uint32_t xor_of[2][kChunks][16]{};  // by dimension 1 or 2, chunk, chunk value
 };
-constexpr ChunkTables make_chunk_tables() {
-  ChunkTables t;
+template <int Columns>
+constexpr ChunkTables<Columns> make_chunk_tables(const std::uint32_t (&columns)[2][Columns]) {
+  ChunkTables<Columns> t;
   for (int d = 0; d < 2; ++d)
-    for (int k = 0; k < kChunks; ++k)
+    for (int k = 0; k < ChunkTables<Columns>::kChunks; ++k)
       for (std::uint32_t bits = 0; bits < 16; ++bits)
         for (int b = 0; b < 4; ++b)
-          if ((bits >> b) & 1u) t.xor_of[d][k][bits] ^= kReversedDirections.column[d][4 * k + b];
+          if ((bits >> b) & 1u) t.xor_of[d][k][bits] ^= columns[d][4 * k + b];
   return t;
 }
-inline constexpr ChunkTables kChunkTables = make_chunk_tables();
+inline constexpr ChunkTables<kBits> kSobolTables = make_chunk_tables(kDirections.column);
+inline constexpr ChunkTables<kIndexBits> kReversedTables = make_chunk_tables(kReversedDirections.column);
 
-template <class U>
-PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
-  if (dim == 0) return index;  // van der Corput is the reversal itself
-  const auto& table = kChunkTables.xor_of[dim - 1];
+template <class U, int Columns>
+PDFLAB_QMC U gf2_product(const U& index, const std::uint32_t (&table)[Columns / 4][16],
+                         const std::uint32_t (&columns)[Columns]) {
+  constexpr int chunks = Columns / 4;
   if constexpr (std::is_integral_v<U>) {
     U result = 0;
-    for (int k = 0; k < kChunks; ++k) result ^= table[k][(index >> (4 * k)) & 15u];
+    for (int k = 0; k < chunks; ++k) result ^= table[k][(index >> (4 * k)) & 15u];
     return result;
   } else {
     U result = index ^ index;  // zero, of U's type
@@ -165,7 +154,7 @@ PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
     if constexpr (lanes == 8 || lanes == 16) {
       // A table of sixteen is one vector of sixteen lanes, or two of eight:
       // one lane-wise look-up (a permute) a chunk.
-      for (int k = 0; k < kChunks; ++k) {
+      for (int k = 0; k < chunks; ++k) {
         const U chunk = (index >> (4 * k)) & 15u;
         if constexpr (lanes == 16) {
           U t;
@@ -182,10 +171,23 @@ PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
     }
 #endif
     // Narrower vectors (and clang, which has no look-up by lane): bit by bit.
-    const std::uint32_t* column = kReversedDirections.column[dim - 1];
-    for (int k = 0; k < kIndexBits; ++k) result ^= column[k] & (0u - ((index >> k) & 1u));
+    for (int k = 0; k < Columns; ++k) result ^= columns[k] & (0u - ((index >> k) & 1u));
     return result;
   }
+}
+
+// Sobol dimension `dim` (0, 1 or 2) of point `index`, unscrambled, as 32 bits.
+template <class U>
+PDFLAB_QMC U sobol(const U& index, int dim) {
+  if (dim == 0) return reverse_bits(index);
+  return gf2_product<U, kBits>(index, kSobolTables.xor_of[dim - 1], kDirections.column[dim - 1]);
+}
+
+// reverse_bits(sobol(i, dim)) for i below 2^kIndexBits (its low kIndexBits bits).
+template <class U>
+PDFLAB_QMC U sobol_reversed(const U& index, int dim) {
+  if (dim == 0) return index;  // van der Corput is the reversal itself
+  return gf2_product<U, kIndexBits>(index, kReversedTables.xor_of[dim - 1], kReversedDirections.column[dim - 1]);
 }
 
 // What each draw group of a vertex is, for its seed.
