@@ -16,6 +16,11 @@ namespace pdflab {
 
 using Clock = std::chrono::steady_clock;
 
+namespace {
+// Without published images, a sweep waits for the film to grow by 1/kSweepGrowth.
+constexpr std::uint32_t kSweepGrowth = 4;
+}  // namespace
+
 RenderSession::RenderSession(int threads) { start_workers(threads); }
 
 RenderSession::RenderSession(const SessionOptions& options) : options_(options) { start_workers(options.threads); }
@@ -94,6 +99,7 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   }
   samples_done_ = 0;
   noise_ = NoiseSummary{};
+  next_sweep_spp_ = 0;
   seconds_before_ = 0.0;
   running_clock_ = false;
   next_pass_spp_ = 1;
@@ -137,7 +143,8 @@ void RenderSession::start_pass_locked() {
   }
   pass_.tiles_x = (pass_.width + kTile - 1) / kTile;
   pass_.tiles = pass_.tiles_x * ((pass_.height + kTile - 1) / kTile);
-  if (!pass_.preview) {
+  pass_.sweep = !pass_.preview && (options_.publish_images || spp_done_ + pass_.spp >= next_sweep_spp_);
+  if (pass_.sweep) {
     tile_noise_.assign(static_cast<std::size_t>(pass_.tiles), NoiseSums{});
     if (options_.publish_images) {  // every pixel is written by its tile's sweep
       spare_rse_.resize(film_.pixel_count());
@@ -190,9 +197,12 @@ void RenderSession::finish_pass_locked() {
   // against passes of 30-120 ms while every other worker waited (the book
   // mixture on two threads: 3.5% more samples a second without that wait;
   // the more threads, the more they waited).
-  NoiseSums sums;
-  for (const NoiseSums& tile : tile_noise_) sums.add(tile);
-  noise_ = sums.summary();
+  if (pass_.sweep) {
+    NoiseSums sums;
+    for (const NoiseSums& tile : tile_noise_) sums.add(tile);
+    noise_ = sums.summary();
+    next_sweep_spp_ = spp_done_ + std::max<std::uint32_t>(1, spp_done_ / kSweepGrowth);
+  }
   if (options_.publish_images) {
     spare_drops_ = film_.drop_masks();
     publish_locked(spare_rgb_, pass_);
@@ -325,6 +335,7 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
   }
   // The tile's pixels are final for this pass: sweep them for the noise
   // figures and, for a viewer, the published image and noise map.
+  if (!pass.sweep) return;
   float* map = options_.publish_images ? spare_rse_.data() : nullptr;
   float* rgb = options_.publish_images ? spare_rgb_.data() : nullptr;
   tile_noise_[static_cast<std::size_t>(tile)] = sweep_noise_rect(film_, x0, y0, x1, y1, kRelMseEpsilon, map, rgb);

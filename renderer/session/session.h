@@ -96,7 +96,10 @@ struct SessionOptions {
   std::function<void()> on_image;
   // False for a headless render that reads the film at the end: no image,
   // noise map or drop mask is published after each pass, so the session holds
-  // the film and nothing else of the image's size.
+  // the film and nothing else of the image's size; and the noise figures
+  // (SessionStats::estimated_relmse) are swept only on a pass that takes the
+  // film to a quarter more samples than the last swept one, as
+  // many as a history of the estimate against the samples needs.
   bool publish_images = true;
 };
 
@@ -157,6 +160,7 @@ class RenderSession {
     bool preview = false;
     int preview_scale = 1;  // preview pixel = preview_scale x preview_scale image pixels
     int width = 0, height = 0;  // of the grid the tiles cover
+    bool sweep = false;  // a full pass whose tiles are swept for the noise figures
   };
 
   void start_workers(int threads);
@@ -201,7 +205,8 @@ class RenderSession {
   bool preview_due_ = false;          // the next pass of this generation is a preview
   double full_samples_per_second_ = 0.0;  // measured on full passes, sizes the preview
   std::vector<float> preview_;        // preview pixels, written by workers (disjoint)
-  NoiseSummary noise_;                // of the last full pass
+  NoiseSummary noise_;                // of the last swept full pass
+  std::uint32_t next_sweep_spp_ = 0;  // without published images: the film's spp that the next sweep waits for
   // Each tile's noise sums in the open full pass, written by the worker that
   // rendered the tile as soon as it has (disjoint slots), added in tile order
   // when the pass ends.
