@@ -24,7 +24,7 @@ SEEDS=${SEEDS:-4}
 REF_FACTOR=${REF_FACTOR:-48}
 THREADS=${THREADS:-0}
 OUT=${OUT:-$(mktemp -d)}
-CANDIDATES=${CANDIDATES:-"mix:cosine=0.5,light=0.5;mix:cosine=0.5,light=0.5+sobol;nee-mis;nee-mis+sobol;nee-mis+sobol+rr;nee-mis+sobol+rr:5;nee-mis+mix:cosine=0.5,light=0.5;nee-mis+mix:cosine=0.5,light=0.5+sobol"}
+CANDIDATES=${CANDIDATES:-"mix:cosine=0.5,light=0.5;fastest;nee-mis;nee-mis+sobol;nee-mis+mix:cosine=0.8,specular-objects=0.2+sobol+rr:8"}
 die() { echo "fastest_report: $*" >&2; exit 2; }
 [[ -x $PDFLAB ]] || die "no binary at $PDFLAB"
 [[ $REF_FACTOR =~ ^[0-9]+$ ]] && (( REF_FACTOR >= 32 )) || die "REF_FACTOR must be a whole number of at least 32"
