@@ -138,24 +138,24 @@ NoiseSums sweep_noise_rect(const Film& film, int x0, int y0, int x1, int y1, dou
   std::uint32_t count = 0;  // after a full pass every pixel has the same count
   Film::Reciprocals r = Film::reciprocals(count);
   const auto width = static_cast<std::size_t>(film.width());
-  for (int y = y0; y < y1; ++y)
-  for (std::size_t p = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x0),
-                   end = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x1);
-       p < end; ++p) {
-    if (film.count(p) != count) r = Film::reciprocals(count = film.count(p));
-    double m[3], v[3];
-    film.moments(p, r, m, v);
-    if (mean_rgb)
-      for (int c = 0; c < 3; ++c) mean_rgb[3 * p + c] = static_cast<float>(m[c]);
-    if (count < 2) {
-      if (map) map[p] = 0.0f;
-      continue;
+  for (int y = y0; y < y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    for (std::size_t p = row + static_cast<std::size_t>(x0); p < row + static_cast<std::size_t>(x1); ++p) {
+      if (film.count(p) != count) r = Film::reciprocals(count = film.count(p));
+      double m[3], v[3];
+      film.moments(p, r, m, v);
+      if (mean_rgb)
+        for (int c = 0; c < 3; ++c) mean_rgb[3 * p + c] = static_cast<float>(m[c]);
+      if (count < 2) {
+        if (map) map[p] = 0.0f;
+        continue;
+      }
+      const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
+      if (map) map[p] = static_cast<float>(rse);
+      sums.relative_standard_error += rse;
+      for (int c = 0; c < 3; ++c) sums.relative_variance += v[c] / (m[c] * m[c] + epsilon);
+      ++sums.pixels;
     }
-    const double rse = std::sqrt(luminance(v) > 0.0 ? luminance(v) : 0.0) / (luminance(m) + epsilon);
-    if (map) map[p] = static_cast<float>(rse);
-    sums.relative_standard_error += rse;
-    for (int c = 0; c < 3; ++c) sums.relative_variance += v[c] / (m[c] * m[c] + epsilon);
-    ++sums.pixels;
   }
   return sums;
 }
