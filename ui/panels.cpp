@@ -252,8 +252,9 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
   // The stratified sampler, for any strategy.
   ImGui::Checkbox("Sobol sampler", &s.sobol);
   if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("The first two vertices' random numbers from Owen-scrambled Sobol points, stratified\n"
-                      "across each pixel's samples (+sobol); off: every number independent");
+    ImGui::SetTooltip("Owen-scrambled Sobol points for %s random numbers, stratified\n"
+                      "across each pixel's samples (+sobol); off: every number independent",
+                      stratified_vertices().c_str());
 
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;

@@ -94,6 +94,10 @@ float parse_weight(std::string_view text, std::string_view whole) {
 const TechniqueInfo& technique_info(Technique t) { return kTable[static_cast<int>(t)]; }
 std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)].name; }
 
+std::string stratified_vertices() {
+  return qmc::kDepths == 1 ? "the first vertex's" : "the first " + std::to_string(qmc::kDepths) + " vertices'";
+}
+
 std::string strategy_help() {
   std::string out =
       "Strategies: BASE[+sobol][+rr[:D]] | fastest[+sobol][+rr[:D]]\n"
@@ -107,8 +111,8 @@ std::string strategy_help() {
       "  +rr[:D]: Russian roulette from D path segments on (default " + std::to_string(kDefaultRouletteDepth) +
       "): a path goes on with probability\n"
       "    min(1, largest throughput component), its throughput divided by it (unbiased; off by default)\n"
-      "  +sobol: the first " + std::to_string(qmc::kDepths) +
-      " vertices' draws (continuation, light sample, specular bounce) from Owen-scrambled Sobol points\n"
+      "  +sobol: " + stratified_vertices() +
+      " draws (continuation, light sample, specular bounce) from Owen-scrambled Sobol points\n"
       "    stratified across a pixel's samples, the rest from the sample's random stream (unbiased;\n"
       "    off by default: every draw independent)\n"
       "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +

@@ -23,6 +23,9 @@ const TechniqueInfo& technique_info(Technique t);
 // The strategy grammar and every technique in the table (what it draws, its
 // pdf, whether it is biased alone): the text of `--help`.
 std::string strategy_help();
+// Which vertices the `+sobol` sampler stratifies, in words ("the first
+// vertex's", from qmc::kDepths), for the help and the panel.
+std::string stratified_vertices();
 std::string_view technique_name(Technique t);
 
 // What `fastest` expands to: pdflab's most efficient unbiased strategy for
