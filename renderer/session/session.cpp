@@ -274,12 +274,13 @@ void RenderSession::worker_main() {
 
     DropCounts local;
     for (;;) {
-      const int tile = next_tile_.fetch_add(1, std::memory_order_relaxed);
+      int count = 1;
+      const int tile = pass.preview ? next_tile_.fetch_add(1, std::memory_order_relaxed) : claim_tiles(pass, count);
       if (tile >= pass.tiles) break;
       if (generation_.load(std::memory_order_relaxed) != pass.generation) break;
       if (pass.preview) render_preview_tile(pass, tile, local);
-      else render_tile(pass, tile, local);
-      tiles_finished_.fetch_add(1, std::memory_order_relaxed);
+      else render_tiles(pass, tile, count, local);
+      tiles_finished_.fetch_add(static_cast<std::uint64_t>(count), std::memory_order_relaxed);
     }
 
     lk.lock();
@@ -289,11 +290,22 @@ void RenderSession::worker_main() {
   }
 }
 
-void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
+int RenderSession::claim_tiles(const Pass& pass, int& count) {
+  const int workers = std::max(1, static_cast<int>(workers_.size()));
+  int first = next_tile_.load(std::memory_order_relaxed);
+  for (;;) {
+    if (first >= pass.tiles) return first;
+    const int row_end = (first / pass.tiles_x + 1) * pass.tiles_x;
+    count = std::clamp((pass.tiles - first) / (2 * workers), 1, std::min(kMaxRun, row_end - first));
+    if (next_tile_.compare_exchange_weak(first, first + count, std::memory_order_relaxed)) return first;
+  }
+}
+
+void RenderSession::render_tiles(const Pass& pass, int first, int count, DropCounts& drops) {
   const Scene& scene = *settings_.scene;
-  const int x0 = (tile % pass.tiles_x) * kTile;
-  const int y0 = (tile / pass.tiles_x) * kTile;
-  const int x1 = std::min(x0 + kTile, scene.camera.width);
+  const int x0 = (first % pass.tiles_x) * kTile;
+  const int y0 = (first / pass.tiles_x) * kTile;
+  const int x1 = std::min(x0 + count * kTile, scene.camera.width);
   const int y1 = std::min(y0 + kTile, scene.camera.height);
   // Several paths at a time (packet.h), a few thousand samples per call into
   // a buffer on the stack (no heap in the render loop). The samples come back
@@ -333,12 +345,15 @@ void RenderSession::render_tile(const Pass& pass, int tile, DropCounts& drops) {
           done += n;
         }
   }
-  // The tile's pixels are final for this pass: sweep them for the noise
-  // figures and, for a viewer, the published image and noise map.
+  // The tiles' pixels are final for this pass: sweep them, tile by tile, for
+  // the noise figures and, for a viewer, the published image and noise map.
   if (!pass.sweep) return;
   float* map = options_.publish_images ? spare_rse_.data() : nullptr;
   float* rgb = options_.publish_images ? spare_rgb_.data() : nullptr;
-  tile_noise_[static_cast<std::size_t>(tile)] = sweep_noise_rect(film_, x0, y0, x1, y1, kRelMseEpsilon, map, rgb);
+  for (int t = 0; t < count; ++t) {
+    const int tx0 = x0 + t * kTile, tx1 = std::min(tx0 + kTile, x1);
+    tile_noise_[static_cast<std::size_t>(first + t)] = sweep_noise_rect(film_, tx0, y0, tx1, y1, kRelMseEpsilon, map, rgb);
+  }
 }
 
 void RenderSession::render_preview_tile(const Pass& pass, int tile, DropCounts& drops) {

@@ -165,7 +165,14 @@ class RenderSession {
 
   void start_workers(int threads);
   void worker_main();
-  void render_tile(const Pass& pass, int tile, DropCounts& drops);
+  // The next run of neighbouring tiles in one tile row (its first tile; `count`
+  // of them), or a first tile past the pass's when none is left. A run is
+  // longer while much of the pass is left (at most kMaxRun tiles, and at most
+  // the tiles left over twice the workers) so that the workers still end a
+  // pass together.
+  int claim_tiles(const Pass& pass, int& count);
+  // A run's samples, traced as blocks of its whole width; then each tile swept.
+  void render_tiles(const Pass& pass, int first, int count, DropCounts& drops);
   void render_preview_tile(const Pass& pass, int tile, DropCounts& drops);
   void publish_locked(std::vector<float>& rgb, const Pass& pass);
   int preview_scale_locked() const;
@@ -176,7 +183,14 @@ class RenderSession {
   void start_pass_locked();
   double elapsed_locked() const;
 
+  // Tiles are the unit of scheduling and of the noise sweep; runs of them the
+  // unit of tracing. The packet tracer's lanes drain at the end of each block it
+  // is given (the last paths run on with the other lanes idle): the book's box at
+  // 600x600 passes 2 samples per pixel, so a 16x16 tile is a block of 512
+  // samples, and tracing runs of 8 tiles (blocks of 4096) gave 7-9% more samples
+  // a second on two threads, the same bits.
   static constexpr int kTile = 16;
+  static constexpr int kMaxRun = 8;
 
   mutable std::mutex mutex_;
   std::condition_variable work_cv_;
