@@ -170,5 +170,26 @@ TEST(Packet, InstructionSetsAreListedWidestLast) {
   }
 }
 
+// PDFLAB_ISA picks an instruction set this machine runs; a name it does not
+// know, or one the machine lacks, falls back to the widest with a warning
+// naming the value (a mistyped name must not pass for a comparison).
+TEST(Packet, RequestedInstructionSetIsHonouredOrWarnedAbout) {
+  const std::vector<PacketIsa> here = available_packet_isas();
+  std::string warning;
+  EXPECT_EQ(choose_packet_isa(nullptr, here, warning), here.back());
+  EXPECT_TRUE(warning.empty());
+  for (const PacketIsa isa : here) {
+    EXPECT_EQ(choose_packet_isa(std::string(packet_isa_name(isa)).c_str(), here, warning), isa);
+    EXPECT_TRUE(warning.empty()) << warning;
+  }
+  EXPECT_EQ(choose_packet_isa("avx-512", here, warning), here.back());
+  EXPECT_NE(warning.find("PDFLAB_ISA=avx-512 is not an instruction set"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("generic, avx2, avx512"), std::string::npos) << warning;
+  // A machine without AVX-512, as the generic-only list stands in for.
+  const std::vector<PacketIsa> baseline{PacketIsa::Generic};
+  EXPECT_EQ(choose_packet_isa("avx512", baseline, warning), PacketIsa::Generic);
+  EXPECT_NE(warning.find("does not run it; using generic"), std::string::npos) << warning;
+}
+
 }  // namespace
 }  // namespace pdflab

@@ -6,9 +6,11 @@
 #include "renderer/integrator/packet.h"
 
 #include <array>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <numbers>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <vector>
@@ -111,16 +113,31 @@ std::vector<PacketIsa> available_packet_isas() {
   return v;
 }
 
+PacketIsa choose_packet_isa(const char* requested, const std::vector<PacketIsa>& here, std::string& warning) {
+  warning.clear();
+  const PacketIsa widest = here.back();
+  if (!requested) return widest;
+  for (const PacketIsa isa : here)
+    if (packet_isa_name(isa) == requested) return isa;
+  std::string known;
+  for (const PacketIsa isa : {PacketIsa::Generic, PacketIsa::Avx2, PacketIsa::Avx512})
+    known += std::string(known.empty() ? "" : ", ") + std::string(packet_isa_name(isa));
+  const bool named = std::string_view(requested) == "generic" || std::string_view(requested) == "avx2" ||
+                     std::string_view(requested) == "avx512";
+  warning = "PDFLAB_ISA=" + std::string(requested) +
+            (named ? ": this machine (or this build) does not run it"
+                   : " is not an instruction set pdflab knows (" + known + ")") +
+            "; using " + std::string(packet_isa_name(widest));
+  return widest;
+}
+
 PacketIsa best_packet_isa() {
   // PDFLAB_ISA=generic, avx2 or avx512 caps the choice (to compare, or to rule the wider code out).
   static const PacketIsa isa = [] {
-    const std::vector<PacketIsa> here = available_packet_isas();
-    PacketIsa best = here.back();
-    const char* requested = std::getenv("PDFLAB_ISA");
-    if (!requested) return best;
-    for (const PacketIsa cap : here)
-      if (packet_isa_name(cap) == requested) return cap;
-    return best;
+    std::string warning;
+    const PacketIsa chosen = choose_packet_isa(std::getenv("PDFLAB_ISA"), available_packet_isas(), warning);
+    if (!warning.empty()) std::fprintf(stderr, "warning: %s\n", warning.c_str());
+    return chosen;
   }();
   return isa;
 }

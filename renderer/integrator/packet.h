@@ -19,6 +19,7 @@
 #include "renderer/integrator/integrator.h"
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -47,6 +48,11 @@ std::vector<PacketIsa> available_packet_isas();
 // one the environment names in PDFLAB_ISA (generic, avx2 or avx512) where it is
 // available.
 PacketIsa best_packet_isa();
+// best_packet_isa's choice among `here` (available_packet_isas) for the
+// PDFLAB_ISA value `requested` (null: not set): the one named, or the widest
+// where the name is unknown or this machine lacks it, and then `warning` says
+// so (best_packet_isa prints it once, on stderr); otherwise `warning` is empty.
+PacketIsa choose_packet_isa(const char* requested, const std::vector<PacketIsa>& here, std::string& warning);
 std::string_view packet_isa_name(PacketIsa isa);
 int packet_lanes(PacketIsa isa);  // paths traced together
 
