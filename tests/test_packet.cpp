@@ -178,6 +178,8 @@ TEST(Packet, RequestedInstructionSetIsHonouredOrWarnedAbout) {
   std::string warning;
   EXPECT_EQ(choose_packet_isa(nullptr, here, warning), here.back());
   EXPECT_TRUE(warning.empty());
+  EXPECT_EQ(choose_packet_isa("", here, warning), here.back());
+  EXPECT_TRUE(warning.empty());
   for (const PacketIsa isa : here) {
     EXPECT_EQ(choose_packet_isa(std::string(packet_isa_name(isa)).c_str(), here, warning), isa);
     EXPECT_TRUE(warning.empty()) << warning;

@@ -116,7 +116,7 @@ std::vector<PacketIsa> available_packet_isas() {
 PacketIsa choose_packet_isa(const char* requested, const std::vector<PacketIsa>& here, std::string& warning) {
   warning.clear();
   const PacketIsa widest = here.back();
-  if (!requested) return widest;
+  if (!requested || !*requested) return widest;  // unset, or set empty
   for (const PacketIsa isa : here)
     if (packet_isa_name(isa) == requested) return isa;
   std::string known;

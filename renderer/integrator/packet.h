@@ -49,7 +49,7 @@ std::vector<PacketIsa> available_packet_isas();
 // available.
 PacketIsa best_packet_isa();
 // best_packet_isa's choice among `here` (available_packet_isas) for the
-// PDFLAB_ISA value `requested` (null: not set): the one named, or the widest
+// PDFLAB_ISA value `requested` (null or empty: not set): the one named, or the widest
 // where the name is unknown or this machine lacks it, and then `warning` says
 // so (best_packet_isa prints it once, on stderr); otherwise `warning` is empty.
 PacketIsa choose_packet_isa(const char* requested, const std::vector<PacketIsa>& here, std::string& warning);
