@@ -45,15 +45,29 @@
 #define PDFLAB_PACKET_DISPATCH 0
 #endif
 
+#include "renderer/sampling/mixture.h"  // the one-path tracer's leaf math
 #include "renderer/sampling/sobol.h"  // its templates run on the kernel's vectors too
+
+#include <bit>
+#include <glm/gtc/type_ptr.hpp>
 
 namespace pdflab {
 
+#define PDFLAB_PACKET_ONE 0
 #define PDFLAB_PACKET_AVX2 0
 #define PDFLAB_PACKET_AVX512 0
 namespace packet_generic {
-#include "renderer/integrator/packet_kernel.inc"
+#include "renderer/integrator/kernel.inc"
 }  // namespace packet_generic
+
+// One lane: the one-path tracer (trace_path), the same code as every packet.
+#undef PDFLAB_PACKET_ONE
+#define PDFLAB_PACKET_ONE 1
+namespace packet_one {
+#include "renderer/integrator/kernel.inc"
+}  // namespace packet_one
+#undef PDFLAB_PACKET_ONE
+#define PDFLAB_PACKET_ONE 0
 
 #if PDFLAB_PACKET_DISPATCH
 #pragma GCC push_options
@@ -61,7 +75,7 @@ namespace packet_generic {
 #undef PDFLAB_PACKET_AVX2
 #define PDFLAB_PACKET_AVX2 1
 namespace packet_avx2 {
-#include "renderer/integrator/packet_kernel.inc"
+#include "renderer/integrator/kernel.inc"
 }  // namespace packet_avx2
 #pragma GCC pop_options
 
@@ -73,10 +87,11 @@ namespace packet_avx2 {
 #undef PDFLAB_PACKET_AVX512
 #define PDFLAB_PACKET_AVX512 1
 namespace packet_avx512 {
-#include "renderer/integrator/packet_kernel.inc"
+#include "renderer/integrator/kernel.inc"
 }  // namespace packet_avx512
 #pragma GCC pop_options
 #endif
+#undef PDFLAB_PACKET_ONE
 #undef PDFLAB_PACKET_AVX2
 #undef PDFLAB_PACKET_AVX512
 
@@ -195,6 +210,15 @@ void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, co
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
                  SampleResult* out) {
   trace_block(best_packet_isa(), scene, plan, seed, block, out);
+}
+
+// The one-path tracer (integrator.h) is the packet tracer's code on one lane.
+Vec3 trace_path(const Scene& scene, const SamplingPlan& plan, Ray ray, Rng& rng, DropCounts& drops,
+                PathRecord* record) {
+  const SampleResult r = packet_one::trace_path_impl(scene, plan, ray, rng, record);
+  for (int reason = 0; reason < kDropReasonCount; ++reason)
+    if (r.drops & (1u << reason)) drops.add(static_cast<DropReason>(reason));
+  return r.radiance;
 }
 
 }  // namespace pdflab
