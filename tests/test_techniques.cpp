@@ -167,7 +167,22 @@ TEST(Techniques, TableDrivesParserAndMessages) {
     const Strategy s = Strategy::parse(info.name);
     EXPECT_EQ(s.weights[i], 1.0f) << info.name;
     EXPECT_EQ(Strategy::parse(s.to_string()), s) << info.name;
-    EXPECT_EQ(s.is_unbiased(), info.covers_hemisphere) << info.name;
+    // Alone, biased exactly where the row gives a reason, and the strategy's
+    // reason names the technique with it.
+    const std::string reason = info.bias_alone(info.parameter_default);
+    EXPECT_EQ(s.is_unbiased(), reason.empty()) << info.name;
+    EXPECT_EQ(s.bias_reason().empty(), reason.empty()) << info.name;
+    if (!reason.empty()) {
+      EXPECT_NE(s.bias_reason().find(std::string(info.name)), std::string::npos) << s.bias_reason();
+      EXPECT_NE(s.bias_reason().find(reason), std::string::npos) << s.bias_reason();
+      EXPECT_NE(strategy_help().find(reason), std::string::npos) << info.name;
+    }
+    // Mixed with cosine, which covers the hemisphere, every technique is unbiased.
+    if (t != Technique::Cosine) {
+      const Strategy mixed = Strategy::parse("mix:cosine=1," + std::string(info.name) + "=1");
+      EXPECT_TRUE(mixed.is_unbiased()) << info.name;
+      EXPECT_TRUE(mixed.bias_reason().empty()) << mixed.bias_reason();
+    }
     EXPECT_NE(unknown_message.find(std::string(info.name)), std::string::npos) << info.name;
     EXPECT_NE(strategy_help().find(std::string(info.name)), std::string::npos) << info.name;
     EXPECT_FALSE(info.draws.empty());
@@ -182,6 +197,7 @@ TEST(Techniques, TableDrivesParserAndMessages) {
   EXPECT_THROW((void)Strategy::parse("cosine-power:1e9"), InputError);
   EXPECT_THROW((void)Strategy::parse("cosine-power:"), InputError);
 }
+
 
 }  // namespace
 }  // namespace pdflab

@@ -89,6 +89,21 @@ float parse_weight(std::string_view text, std::string_view whole) {
   return value;
 }
 
+// " (biased alone: it REASON)" for --help, at the parameter's default; for a
+// technique biased alone at some of its parameter's values only, also an end
+// of the range where it is not (or is).
+std::string bias_help(const TechniqueInfo& t) {
+  const std::string at_default = t.bias_alone(t.parameter_default);
+  const float ends[] = {t.parameter_min, t.parameter_max};
+  for (const float end : ends) {
+    if (t.parameter.empty() || t.bias_alone(end).empty() == at_default.empty()) continue;
+    const std::string at = std::string(t.parameter) + " = " + format_number(end);
+    if (at_default.empty()) return " (biased alone at " + at + ": it " + t.bias_alone(end) + ")";
+    return " (biased alone: it " + at_default + "; unbiased at " + at + ")";
+  }
+  return at_default.empty() ? "" : " (biased alone: it " + at_default + ")";
+}
+
 }  // namespace
 
 const TechniqueInfo& technique_info(Technique t) { return kTable[static_cast<int>(t)]; }
@@ -121,13 +136,12 @@ std::string strategy_help() {
     std::string name(t.name);
     if (!t.parameter.empty())
       name.append("[:").append(t.parameter).append("]");
-    out.append("  ").append(name).append(name.size() < 20 ? 20 - name.size() : 1, ' ');
+    out.append("  ").append(name).append(name.size() < 22 ? 22 - name.size() : 1, ' ');
     out.append(t.draws).append("; pdf ").append(t.pdf);
     if (!t.parameter.empty())
       out.append("; ").append(t.parameter).append(" in [").append(format_number(t.parameter_min)).append(", ")
           .append(format_number(t.parameter_max)).append("], default ").append(format_number(t.parameter_default));
-    if (!t.covers_hemisphere) out.append(" (biased alone: sees only its targets)");
-    out.append("\n");
+    out.append(bias_help(t)).append("\n");
   }
   return out;
 }
@@ -315,8 +329,22 @@ std::string Strategy::mixture_string() const {
 
 bool Strategy::is_unbiased() const {
   for (int i = 0; i < kTechniqueCount; ++i)
-    if (kTable[i].covers_hemisphere && uses(static_cast<Technique>(i))) return true;
+    if (uses(static_cast<Technique>(i)) && kTable[i].bias_alone(parameters[i]).empty()) return true;
   return false;
+}
+
+std::string Strategy::bias_reason() const {
+  if (is_unbiased()) return {};
+  std::string out;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    if (!uses(static_cast<Technique>(i))) continue;
+    const TechniqueInfo& t = kTable[i];
+    std::string name(t.name);
+    if (!t.parameter.empty()) name.append(":").append(format_number(parameters[i]));
+    out.append(out.empty() ? "" : ", ").append(name).append(" ").append(t.bias_alone(parameters[i]));
+  }
+  if (nee_mis) out.insert(0, "its continuation misses light: ");
+  return out;
 }
 
 }  // namespace pdflab

@@ -95,9 +95,13 @@ struct Strategy {
   bool cosine_continuation() const;
 
   // Unbiased iff some technique with positive weight covers the whole
-  // hemisphere above a diffuse surface (TechniqueInfo::covers_hemisphere);
-  // for nee-mis, the continuation's. Russian roulette changes nothing here.
+  // hemisphere above a diffuse surface with its parameter (TechniqueInfo::bias
+  // is empty); for nee-mis, the continuation's. Russian roulette changes
+  // nothing here.
   bool is_unbiased() const;
+  // Why the strategy is biased, naming each technique and what it misses
+  // ("light sees only its targets"); empty when it is unbiased.
+  std::string bias_reason() const;
   bool uses(Technique t) const { return weights[static_cast<int>(t)] > 0.0f; }
   bool operator==(const Strategy&) const = default;
 

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 namespace pdflab {
@@ -43,20 +44,29 @@ enum class Technique : std::uint8_t {
 };
 inline constexpr int kTechniqueCount = static_cast<int>(Technique::Count);
 
-// What the rest of the program knows of a technique besides its math.
+// What the rest of the program knows of a technique besides its math, as a
+// row with named fields (TechniqueInfo{.name = ..., .pdf = ...}).
 struct TechniqueInfo {
-  std::string_view name;      // as typed in a strategy
-  std::string_view draws;     // what it draws, for --help and the README
-  std::string_view pdf;       // its density, as a formula
-  // Its pdf is positive over the whole hemisphere above a diffuse surface:
-  // alone it is unbiased; the light techniques cover only their targets.
-  bool covers_hemisphere;
-  bool draws_target;  // draws one more random number, for the target
-  std::array<std::uint8_t, 3> colour;  // its samples in the probe
-  // A parameter written `name:P` (0 chars: none), its default and range.
-  std::string_view parameter;
+  std::string_view name{};   // as typed in a strategy
+  std::string_view draws{};  // what it draws, for --help and the README
+  std::string_view pdf{};    // its density, as a formula
+  // Why the technique alone is biased with its parameter at `p`: the part of
+  // the hemisphere above a diffuse surface where its pdf is zero, said as what
+  // it does ("sees only its targets"). Empty, or no function at all: its pdf
+  // is positive over the whole hemisphere, and alone it is unbiased.
+  std::string (*bias)(float p) = nullptr;
+  bool draws_target = false;  // draws one more random number, for the target
+  std::array<std::uint8_t, 3> colour{};  // its samples in the probe
+  // A parameter written `name:P` (empty: none), its default and range.
+  std::string_view parameter{};
   float parameter_default = 0.0f, parameter_min = 0.0f, parameter_max = 0.0f;
+
+  // bias(p), or empty where there is no function.
+  std::string bias_alone(float p) const { return bias ? bias(p) : std::string(); }
 };
+
+// The light techniques' bias: they draw only directions towards their targets.
+inline std::string sees_only_its_targets(float) { return "sees only its targets"; }
 
 }  // namespace pdflab
 
