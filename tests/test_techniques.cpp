@@ -198,6 +198,26 @@ TEST(Techniques, TableDrivesParserAndMessages) {
   EXPECT_THROW((void)Strategy::parse("cosine-power:"), InputError);
 }
 
+// A technique's bias can depend on its parameter: uniform-cone covers the
+// hemisphere at 90 degrees alone, and the reason it gives below says how far
+// it reaches, in --help, in the strategy's reason and in `reference`'s refusal.
+TEST(Techniques, BiasFollowsTheParameter) {
+  EXPECT_TRUE(Strategy::parse("uniform-cone:90").is_unbiased());
+  EXPECT_TRUE(Strategy::parse("uniform-cone:90").bias_reason().empty());
+  const Strategy narrow = Strategy::parse("uniform-cone:45");
+  EXPECT_FALSE(narrow.is_unbiased());
+  EXPECT_EQ(narrow.bias_reason(), "uniform-cone:45 reaches only directions within 45 degrees of the normal");
+  EXPECT_NE(strategy_help().find("uniform-cone[:ANGLE]"), std::string::npos);
+  EXPECT_NE(strategy_help().find("(biased alone: it reaches only directions within 30 degrees of the normal; "
+                                 "unbiased at ANGLE = 90)"),
+            std::string::npos)
+      << strategy_help();
+  const Strategy both = Strategy::parse("mix:light=1,uniform-cone:10=1");
+  EXPECT_EQ(both.bias_reason(),
+            "light sees only its targets, uniform-cone:10 reaches only directions within 10 degrees of the normal");
+  EXPECT_EQ(Strategy::parse("nee-mis+light").bias_reason(), "its continuation misses light: light sees only its targets");
+  EXPECT_TRUE(Strategy::parse("nee-mis+mix:light=1,uniform-cone:90=1").is_unbiased());
+}
 
 }  // namespace
 }  // namespace pdflab

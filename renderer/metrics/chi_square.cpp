@@ -1,6 +1,7 @@
 #include "renderer/metrics/chi_square.h"
 
 #include "renderer/integrator/packet.h"
+#include "renderer/sampling/mixture.h"
 
 #include <glm/geometric.hpp>
 
@@ -235,6 +236,33 @@ std::vector<Point> target_outlines(const Scene& scene, const Vec3& origin, const
   return out;
 }
 
+namespace {
+// Technique T's own edges, where it declares any and has weight.
+template <class T>
+void add_edges(const SamplingPlan& plan, const Vec3& normal, std::vector<Vec3>& directions) {
+  if constexpr (requires { T::pdf_edges(plan, normal, directions); })
+    if (plan.weight[static_cast<int>(T::id)] > 0.0f) T::pdf_edges(plan, normal, directions);
+}
+}  // namespace
+
+std::vector<Point> technique_edges(const SamplingPlan& plan, const Vec3& normal, const Frame& frame) {
+  std::vector<Vec3> directions;
+#define PDFLAB_ROW(T) add_edges<leaf::T>(plan, normal, directions);
+  PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
+  std::vector<Point> out;
+  out.reserve(directions.size());
+  for (const Vec3& d : directions) out.push_back(frame.coordinates(d));
+  return out;
+}
+
+std::vector<Point> plan_edges(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, const Frame& frame) {
+  std::vector<Point> edges = plan.scene ? target_outlines(*plan.scene, origin, frame) : std::vector<Point>{};
+  const std::vector<Point> own = technique_edges(plan, normal, frame);
+  edges.insert(edges.end(), own.begin(), own.end());
+  return edges;
+}
+
 std::vector<double> cell_masses(const Grid& grid, const Frame& frame, const Density& density,
                                 const std::vector<Point>& edges) {
   const CellIntegrator integrator(grid, frame, density, edges);
@@ -307,7 +335,7 @@ std::vector<Outcome> check_plan(const SamplingPlan& plan, const Vec3& origin, co
                                 const Grid& grid) {
   const Frame frame(normal);
   const Density density = [&](const Vec3& d) { return static_cast<double>(plan.pdf(origin, normal, d)); };
-  const std::vector<Point> edges = plan.scene ? target_outlines(*plan.scene, origin, frame) : std::vector<Point>{};
+  const std::vector<Point> edges = plan_edges(plan, origin, normal, frame);
   std::vector<Draw> draws;
   for (Sampler which : samplers) draws.push_back(plan_sampler(plan, origin, normal, which));
   return run_each(grid, frame, draws, density, edges, seed, samples);

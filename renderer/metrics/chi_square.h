@@ -51,6 +51,14 @@ using Draw = std::function<DirectionSample(Rng&)>;
 // quadrature's finest pieces.
 std::vector<Point> target_outlines(const Scene& scene, const Vec3& origin, const Frame& frame);
 
+// Points on the curves where the plan's techniques with weight say their own
+// pdf jumps (a cone's edge: TechniqueT::pdf_edges), as seen about `normal`.
+std::vector<Point> technique_edges(const SamplingPlan& plan, const Vec3& normal, const Frame& frame);
+
+// Everything above for a plan: its scene's targets' outlines and its
+// techniques' own edges.
+std::vector<Point> plan_edges(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, const Frame& frame);
+
 // The pdf integrated over each cell (probability, not counts), row-major.
 // Measured over the test suite's cases, the sphere's total is off by at most
 // 4.3e-5 (a thin sliver of a light seen edge-on) and below 2e-5 elsewhere.

@@ -6,7 +6,11 @@
 #include "renderer/sampling/leaf.h"
 #include "renderer/sampling/strategy.h"
 
+#include <cmath>
 #include <concepts>
+#include <cstdio>
+#include <numbers>
+#include <vector>
 
 namespace pdflab::leaf {
 #define PDFLAB_LEAF inline

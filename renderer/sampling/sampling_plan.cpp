@@ -72,8 +72,19 @@ void SamplingPlan::bind_targets() {
   specular_objects = specular_object_set(*scene);
 }
 
+// Technique T's constants for parameter p, where it derives any.
+template <class T>
+TechniqueConstants derived_constants(float p) {
+  if constexpr (requires { T::constants(p); }) return T::constants(p);
+  else return {};
+}
+
 void SamplingPlan::set_technique_choice(const Strategy& strategy) {
   parameter = strategy.parameters;
+#define PDFLAB_ROW(T) \
+  constants[static_cast<int>(Technique::T)] = derived_constants<leaf::T>(parameter[static_cast<int>(Technique::T)]);
+  PDFLAB_TECHNIQUES(PDFLAB_ROW)
+#undef PDFLAB_ROW
   const DiscreteDistribution choice = technique_choice(strategy, usable_weights(strategy, *this));
   for (int i = 0; i < kTechniqueCount; ++i) {
     weight[i] = choice.pmf(i);

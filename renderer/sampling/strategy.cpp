@@ -104,6 +104,20 @@ std::string bias_help(const TechniqueInfo& t) {
   return at_default.empty() ? "" : " (biased alone: it " + at_default + ")";
 }
 
+// " (alone: infinite variance, as REASON; finite at P = X)" for --help, at the
+// parameter's default.
+std::string heavy_tail_help(const TechniqueInfo& t) {
+  const std::string at_default = t.heavy_tail_alone(t.parameter_default);
+  if (at_default.empty()) return "";
+  std::string out = " (alone on a diffuse surface: infinite variance, as " + at_default;
+  for (const float end : {t.parameter_min, t.parameter_max})
+    if (!t.parameter.empty() && t.heavy_tail_alone(end).empty()) {
+      out.append("; finite at ").append(t.parameter).append(" = ").append(format_number(end));
+      break;
+    }
+  return out + ")";
+}
+
 }  // namespace
 
 const TechniqueInfo& technique_info(Technique t) { return kTable[static_cast<int>(t)]; }
@@ -141,7 +155,7 @@ std::string strategy_help() {
     if (!t.parameter.empty())
       out.append("; ").append(t.parameter).append(" in [").append(format_number(t.parameter_min)).append(", ")
           .append(format_number(t.parameter_max)).append("], default ").append(format_number(t.parameter_default));
-    out.append(bias_help(t)).append("\n");
+    out.append(bias_help(t)).append(heavy_tail_help(t)).append("\n");
   }
   return out;
 }

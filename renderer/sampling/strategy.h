@@ -128,6 +128,9 @@ struct SamplingPlan {
   std::array<std::uint32_t, kTechniqueCount> choice_threshold{};
   int last_technique = 0;
   std::array<float, kTechniqueCount> parameter{};  // Strategy::parameters
+  // What each technique derives from its parameter, once per plan
+  // (TechniqueConstants; zero for a technique that derives nothing).
+  std::array<TechniqueConstants, kTechniqueCount> constants{};
   bool uses_frame = false;  // a technique with weight draws in the shading frame
   const Scene* scene = nullptr;
   bool nee_mis = false;

@@ -15,6 +15,7 @@
 #include "renderer/sampling/techniques/light_solid_angle.inc"
 #include "renderer/sampling/techniques/cosine_power.inc"
 #include "renderer/sampling/techniques/specular_objects.inc"
+#include "renderer/sampling/techniques/uniform_cone.inc"
 
 #elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
 #define PDFLAB_TECHNIQUE_TABLE_H
@@ -27,7 +28,8 @@
   X(Light)                   \
   X(LightSolidAngle)         \
   X(CosinePower)             \
-  X(SpecularObjects)
+  X(SpecularObjects)         \
+  X(UniformCone)
 
 #include <array>
 #include <cstdint>
@@ -55,18 +57,32 @@ struct TechniqueInfo {
   // it does ("sees only its targets"). Empty, or no function at all: its pdf
   // is positive over the whole hemisphere, and alone it is unbiased.
   std::string (*bias)(float p) = nullptr;
+  // Why the technique alone, on a diffuse surface whose light reaches it from
+  // every direction, has infinite variance with its parameter at `p` (f cos / p
+  // unbounded and square-integrable nowhere near where it grows): an image
+  // that converges, but slowly and unevenly, so no standard error describes
+  // it. Empty, or no function: finite variance.
+  std::string (*heavy_tail)(float p) = nullptr;
   bool draws_target = false;  // draws one more random number, for the target
   std::array<std::uint8_t, 3> colour{};  // its samples in the probe
   // A parameter written `name:P` (empty: none), its default and range.
   std::string_view parameter{};
   float parameter_default = 0.0f, parameter_min = 0.0f, parameter_max = 0.0f;
 
-  // bias(p), or empty where there is no function.
+  // bias(p) and heavy_tail(p), or empty where there is no function.
   std::string bias_alone(float p) const { return bias ? bias(p) : std::string(); }
+  std::string heavy_tail_alone(float p) const { return heavy_tail ? heavy_tail(p) : std::string(); }
 };
 
 // The light techniques' bias: they draw only directions towards their targets.
 inline std::string sees_only_its_targets(float) { return "sees only its targets"; }
+
+// What a technique derives from its parameter once per sampling plan (not per
+// call), for its sample and pdf to read: a technique that needs any defines
+// `static TechniqueConstants constants(float parameter)`.
+struct TechniqueConstants {
+  float value[4] = {};
+};
 
 }  // namespace pdflab
 
