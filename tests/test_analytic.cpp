@@ -17,6 +17,7 @@
 #include "renderer/scene/scene_loader.h"
 
 #include "tests/render_support.h"
+#include "tests/table_strategies.h"
 
 #include <gtest/gtest.h>
 
@@ -265,20 +266,43 @@ TEST_P(Analytic, MatchesTheClosedFormWithinThreeStandardErrors) {
       << (est - truth) / se << ")";
 }
 
+// Whether the strategy gives weight to a technique that draws a target in `scene`.
+bool aims_at_light(const std::string& strategy, const Scene& scene) {
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), scene);
+  for (int i = 0; i < kTechniqueCount; ++i)
+    if (plan.weight[i] > 0.0f && technique_info(static_cast<Technique>(i)).draws_target) return true;
+  return false;
+}
+
 std::vector<Param> cases() {
   std::vector<Param> out;
   // Russian roulette trades samples' cost for their variance: more of them
   // reach the precision the comparison needs.
   const auto light_spp = [](const std::string& s) { return s.find("+rr") != std::string::npos ? 256u : 64u; };
-  const std::vector<std::string> light_strategies = {"light",        "light-sa", "mix:cosine=0.5,light=0.5",
+  std::vector<std::string> light_strategies = {"light",        "light-sa", "mix:cosine=0.5,light=0.5",
                                                      "mix:cosine=0.5,light-sa=0.5", "nee-mis", "nee-mis:balance",
                                                      // continuations drawn by a mixture, Russian roulette
                                                      "nee-mis+mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light=0.5+rr:1",
                                                      "nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr:1",
                                                      // the +sobol sampler
                                                      "mix:cosine=0.5,light=0.5+sobol", "nee-mis+sobol"};
-  const std::vector<std::string> blind_strategies = {"cosine", "uniform-hemisphere",
-                                                     "mix:uniform-sphere=0.5,light=0.5"};
+  // Half of uniform-sphere's samples go below the floor.
+  const auto blind_spp = [](const std::string& s) {
+    return s == "cosine" ? 4096u : s.find("light") != std::string::npos ? 256u : s == "uniform-sphere" ? 16384u : 8192u;
+  };
+  std::vector<std::string> blind_strategies = {"cosine", "uniform-hemisphere", "mix:uniform-sphere=0.5,light=0.5"};
+  // Every technique of the table, alone and mixed with cosine: those that aim
+  // at the light with the light strategies, the others (unbiased) with the blind ones.
+  {
+    AnalyticCase probe;
+    const Scene scene = load_scene_text(scene_json(probe), "probe.json");
+    for (const testing::TableStrategy& t : testing::table_strategies()) {
+      if (t.technique == Technique::SpecularObjects && t.text == "specular-objects") continue;  // no glass or metal here
+      std::vector<std::string>& into = aims_at_light(t.text, scene) ? light_strategies : blind_strategies;
+      if ((&into == &blind_strategies && !t.unbiased) || std::find(into.begin(), into.end(), t.text) != into.end()) continue;
+      into.push_back(t.text);
+    }
+  }
   for (const double scale : {1e-3, 1.0, 1e3, 1e6}) {
     char sc[16];
     std::snprintf(sc, sizeof sc, "s%g", scale);
@@ -296,7 +320,7 @@ std::vector<Param> cases() {
         // Strategies blind to the light find it only when it is large.
         if (size >= 1e-1 && shape == LightShape::Quad)
           for (const auto& s : blind_strategies)
-            out.push_back({c, s, s == "cosine" ? 4096u : s == "uniform-hemisphere" ? 8192u : 256u});
+            out.push_back({c, s, blind_spp(s)});
       }
       // A quad barely above the floor, behind the camera: every floor point in
       // view is nearly in the light's plane and sees it at a grazing angle.

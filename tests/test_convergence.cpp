@@ -11,9 +11,11 @@
 #include "renderer/metrics/statistics.h"
 
 #include "tests/render_support.h"
+#include "tests/table_strategies.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,7 +52,7 @@ constexpr double kFamilyAlpha = 0.01;
 // threshold (about 4.3 for 648 tests) keeps the family's false-alarm rate
 // near 1%.
 struct StrategyRun {
-  const char* strategy;
+  std::string strategy;
   std::uint32_t spp;
 };
 const std::vector<StrategyRun>& unbiased_strategies() {
@@ -79,7 +81,20 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256},
       {"mix:cosine=0.5,light-sa=0.5+sobol+rr", 512},
   };
-  return s;
+  // And every technique of the table alone (where unbiased) and mixed with
+  // cosine (tests/table_strategies.h); alone, a technique gets the uniform
+  // techniques' extra samples.
+  static const std::vector<StrategyRun> with_table = [] {
+    std::vector<StrategyRun> runs = s;
+    for (const testing::TableStrategy& t : testing::table_strategies()) {
+      if (!t.unbiased) continue;
+      if (std::any_of(runs.begin(), runs.end(), [&](const StrategyRun& r) { return t.text == r.strategy; })) continue;
+      const bool alone = t.text.rfind("mix:", 0) != 0;
+      runs.push_back({t.text, alone ? 2048u : 512u});
+    }
+    return runs;
+  }();
+  return with_table;
 }
 // The reference has 8x the samples of most runs, so its own noise is a small
 // part of each comparison's variance (and correlates the comparisons weakly).
@@ -165,7 +180,7 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnBookScene) {
     SCOPED_TRACE(run.strategy);
     ASSERT_TRUE(Strategy::parse(run.strategy).is_unbiased());
     const Comparison cmp = compare(render_blocks(run.strategy, 100 + s, run.spp), reference);
-    std::printf("[convergence] %-48s block z in [%+.2f, %+.2f] (limit %.2f)\n", run.strategy, cmp.most_negative,
+    std::printf("[convergence] %-48s block z in [%+.2f, %+.2f] (limit %.2f)\n", run.strategy.c_str(), cmp.most_negative,
                 cmp.most_positive, limit);
     for (std::size_t i = 0; i < cmp.z.size(); ++i)
       EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;

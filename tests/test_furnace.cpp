@@ -12,6 +12,7 @@
 #include "renderer/metrics/statistics.h"
 
 #include "tests/render_support.h"
+#include "tests/table_strategies.h"
 
 #include <gtest/gtest.h>
 
@@ -54,16 +55,20 @@ constexpr const char* kSceneJson = R"({
                  "importance": true } ]
 })";
 
+// These, and every technique of the table alone (where unbiased) and mixed
+// with cosine (tests/table_strategies.h).
 const std::vector<std::string>& unbiased_strategies() {
-  static const std::vector<std::string> s = {
-      "cosine",
-      "uniform-hemisphere",
-      "uniform-sphere",
-      "mix:cosine=0.5,light=0.5",
-      "mix:cosine=0.75,light=0.25",
-      "mix:uniform-hemisphere=0.5,light=0.5",
-      "mix:cosine=0.4,uniform-sphere=0.2,light=0.4",
-  };
+  static const std::vector<std::string> s = testing::with_table_strategies(
+      {
+          "cosine",
+          "uniform-hemisphere",
+          "uniform-sphere",
+          "mix:cosine=0.5,light=0.5",
+          "mix:cosine=0.75,light=0.25",
+          "mix:uniform-hemisphere=0.5,light=0.5",
+          "mix:cosine=0.4,uniform-sphere=0.2,light=0.4",
+      },
+      [](const testing::TableStrategy& t) { return t.unbiased; });
   return s;
 }
 

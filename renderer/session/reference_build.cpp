@@ -18,8 +18,8 @@ SessionOptions options_for(const ReferenceJob& job) {
 ReferenceBuild::ReferenceBuild(ReferenceJob job) : job_(std::move(job)), session_(options_for(job_)) {
   if (!job_.scene) throw std::invalid_argument("ReferenceBuild without a scene");
   if (!job_.strategy.is_unbiased())
-    throw InputError("strategy '" + job_.strategy.to_string() +
-                     "' is biased (it misses indirect light); a reference needs an unbiased one");
+    throw InputError("strategy '" + job_.strategy.to_string() + "' is biased (" + job_.strategy.bias_reason() +
+                     "); a reference needs an unbiased one");
   const ReferenceGoal& g = job_.goal;
   if ((g.spp > 0) + (g.seconds > 0.0) + (g.relmse > 0.0) != 1)
     throw InputError("give exactly one goal: --spp, --seconds or --target-relmse");
