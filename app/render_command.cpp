@@ -82,18 +82,7 @@ void write_text(const std::string& path, const std::string& text) {
 
 // What an EXR's header says about the estimate in it.
 std::vector<std::pair<std::string, std::string>> image_attributes(const FilmInfo& info) {
-  char hash[24];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(info.scene_hash));
-  std::vector<std::pair<std::string, std::string>> a = {{"pdflab.scene", info.scene_file},
-          {"pdflab.sceneHash", hash},
-          {"pdflab.strategy", info.strategy},
-          {"pdflab.spp", std::to_string(info.spp())},
-          {"pdflab.samples", info.ranges_text()},
-          {"pdflab.maxDepth", std::to_string(info.max_depth)},
-          {"pdflab.version", PDFLAB_VERSION}};
-  // One seed: a reference made from this image knows which random numbers to avoid.
-  if (info.ranges.size() == 1) a.emplace_back("pdflab.seed", std::to_string(info.ranges.front().seed));
-  return a;
+  return film_image_attributes(info, PDFLAB_VERSION);
 }
 
 nlohmann::json drops_json(const DropCounts& dropped) {

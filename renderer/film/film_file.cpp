@@ -149,6 +149,20 @@ std::uint64_t film_scene_hash(const Scene& scene) {
   return std::strtoull(scene.content_hash.c_str(), nullptr, 16);
 }
 
+std::vector<std::pair<std::string, std::string>> film_image_attributes(const FilmInfo& info, const std::string& version) {
+  char hash[24];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(info.scene_hash));
+  std::vector<std::pair<std::string, std::string>> a = {{"pdflab.scene", info.scene_file},
+                                                        {"pdflab.sceneHash", hash},
+                                                        {"pdflab.strategy", info.strategy},
+                                                        {"pdflab.spp", std::to_string(info.spp())},
+                                                        {"pdflab.samples", info.ranges_text()},
+                                                        {"pdflab.maxDepth", std::to_string(info.max_depth)},
+                                                        {"pdflab.version", version}};
+  if (info.ranges.size() == 1) a.emplace_back("pdflab.seed", std::to_string(info.ranges.front().seed));
+  return a;
+}
+
 std::uint64_t FilmInfo::spp() const {
   std::uint64_t n = 0;
   for (const SampleRange& r : ranges) n += r.size();

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pdflab {
@@ -62,6 +63,12 @@ void write_film_file(const std::string& path, const FilmInfo& info, const Film& 
 FilmFile read_film_file(const std::string& path);
 // The same from an open stream of `size` bytes (the fuzzer reads from memory).
 FilmFile read_film_stream(std::FILE* stream, std::uint64_t size, const std::string& name);
+
+// What an image's header (EXR's attributes) says about the estimate in it:
+// scene, its hash, strategy, spp, sample ranges, depth, `version`, and the
+// seed when there is one (a reference made from the image knows which random
+// numbers to avoid).
+std::vector<std::pair<std::string, std::string>> film_image_attributes(const FilmInfo& info, const std::string& version);
 
 // Empty when film `b` may be added to film `a`: the same scene, size, depth and
 // strategy, and no sample of one seed in both. Otherwise one sentence naming

@@ -142,7 +142,15 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   }
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
-  const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(rng.next_u32()) : 0;
+  const std::uint32_t u_target = leaf::draws_target(*this, chosen) ? rng.next_u32() : 0;
+  return sample_at(origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target);
+}
+
+DirectionSample SamplingPlan::sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2,
+                                        std::uint32_t u_technique, std::uint32_t u_target, int* technique) const {
+  const int chosen = leaf::choose_technique(*this, static_cast<std::int32_t>(u_technique));
+  if (technique) *technique = chosen;
+  const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(u_target) : 0;
   return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
 }
 

@@ -162,6 +162,12 @@ struct SamplingPlan {
   // the `+sobol` sampler's stratified draws; -1: every draw from `rng`.
   DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr,
                          int depth = -1) const;
+  // The same draw from given numbers instead of a stream: u1, u2 in [0, 1)
+  // for the direction, 32 bits for the choice of the technique and 32 for the
+  // target (used only where the chosen technique draws one). For checking a
+  // technique against one's own inverse CDF at the very same numbers.
+  DirectionSample sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2, std::uint32_t u_technique,
+                            std::uint32_t u_target, int* technique = nullptr) const;
   // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
             float aimed_t = 0.0f) const;

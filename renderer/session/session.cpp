@@ -498,6 +498,15 @@ Film RenderSession::copy_film() const {
   return film_;
 }
 
+Film RenderSession::take_film() {
+  std::unique_lock lk(mutex_);
+  wait_idle_locked(lk, "take_film");
+  Film taken = std::move(film_);
+  film_ = Film();
+  settings_.scene.reset();  // no pass starts without a scene; new settings bring one and size the film
+  return taken;
+}
+
 void RenderSession::read_film(
     const std::function<void(const Film&, std::uint32_t spp, const DropCounts&)>& read) const {
   std::unique_lock lk(mutex_);

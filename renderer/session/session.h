@@ -149,6 +149,11 @@ class RenderSession {
   // Calls `read` with the film, its spp and drop counts, without copying the
   // film; same conditions as copy_film. Rendering waits while `read` runs.
   void read_film(const std::function<void(const Film&, std::uint32_t spp, const DropCounts&)>& read) const;
+  // Moves the accumulation out, as copy_film without the copy (same
+  // conditions). The session renders nothing more until the next set_settings
+  // or resume: a caller that keeps the film after the session is gone (a
+  // Python Film) needs no second copy of it.
+  Film take_film();
 
  private:
   struct Pass {
