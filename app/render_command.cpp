@@ -144,10 +144,8 @@ Resumed open_resume(const RenderOptions& o) {
   return r;
 }
 
-}  // namespace
-
-int run_render(const RenderOptions& o) {
-  // Everything the user typed is checked before any work starts.
+// Everything the user typed is checked before any file is read.
+void check_render_options(const RenderOptions& o) {
   if (o.resume.empty() && !o.scene_given) throw InputError("--scene is required (unless --resume names a film)");
   if (o.resume.empty() && !o.strategy_given) throw InputError("--strategy is required (unless --resume names a film)");
   if (!o.spp_given) throw InputError("--spp is required");
@@ -162,111 +160,162 @@ int run_render(const RenderOptions& o) {
   if (!film_out.empty()) check_output_path(film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
   check_distinct_outputs({o.out, film_out, o.stats_json});
-  const Transfer transfer = parse_transfer(o.transfer);
+  (void)parse_transfer(o.transfer);
   if (o.threads < 0 || o.threads > 1024) throw InputError("--threads must be in 0..1024 (0: all cores)");
   if (!(o.checkpoint_seconds >= 0.0) || !std::isfinite(o.checkpoint_seconds))
     throw InputError("--checkpoint-seconds must be a number >= 0");
+}
 
+// What is rendered: the scene at its size, the strategy, the samples (seed and
+// first index) and the film it continues, if any; and where the film goes.
+struct RenderPlan {
   std::optional<Resumed> resumed;
-  if (!o.resume.empty()) resumed = open_resume(o);
-  const std::string scene_path = resumed ? resumed->scene : o.scene;
+  std::string scene_path;
+  std::shared_ptr<Scene> scene;
+  Strategy strategy;
+  FilmInfo info;  // the film's description, without its ranges, drops and time
+  std::uint64_t seed = 0;
+  std::uint32_t first_sample = 0;
+  std::string film_out;  // empty: no film is written
+  Transfer transfer = Transfer::Gamma2;
+};
+
+RenderPlan plan_render(const RenderOptions& o) {
+  RenderPlan plan;
+  plan.transfer = parse_transfer(o.transfer);
+  plan.film_out = o.film_out.empty() ? o.resume : o.film_out;
+  if (!o.resume.empty()) plan.resumed = open_resume(o);
+  const std::optional<Resumed>& resumed = plan.resumed;
+  plan.scene_path = resumed ? resumed->scene : o.scene;
   const std::string strategy_text = resumed ? resumed->strategy : o.strategy;
 
-  auto scene = std::make_shared<Scene>(load_scene_file(scene_path));
+  plan.scene = std::make_shared<Scene>(load_scene_file(plan.scene_path));
+  Scene& scene = *plan.scene;
   const int width = resumed ? resumed->file.info.width : o.width;
   const int height = resumed ? resumed->file.info.height : o.height;
-  if (width != 0) scene->camera.width = width;
-  if (height != 0) scene->camera.height = height;
-  if (width != 0 || height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
-  scene->prepare();
-  const Strategy strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
-  (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
+  if (width != 0) scene.camera.width = width;
+  if (height != 0) scene.camera.height = height;
+  if (width != 0 || height != 0) check_image_size(scene.camera.width, scene.camera.height, "--width/--height");
+  scene.prepare();
+  plan.strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
+  (void)SamplingPlan::make(plan.strategy, scene);  // strategy/scene mismatch is bad input too
 
-  FilmInfo info;
-  info.scene_hash = film_scene_hash(*scene);
-  info.scene_file = scene_path;
-  info.width = scene->camera.width;
-  info.height = scene->camera.height;
-  info.max_depth = scene->max_depth;
-  info.strategy = strategy.to_string();
-  const std::uint64_t seed = resumed ? resumed->file.info.ranges.front().seed : o.seed;
-  const std::uint32_t first_sample = resumed ? resumed->file.info.ranges.front().first : o.first_sample;
-  if (std::uint64_t{first_sample} + o.spp > std::numeric_limits<std::uint32_t>::max())
-    throw InputError("--first-sample " + std::to_string(first_sample) + " plus --spp " + std::to_string(o.spp) +
+  FilmInfo& info = plan.info;
+  info.scene_hash = film_scene_hash(scene);
+  info.scene_file = plan.scene_path;
+  info.width = scene.camera.width;
+  info.height = scene.camera.height;
+  info.max_depth = scene.max_depth;
+  info.strategy = plan.strategy.to_string();
+  plan.seed = resumed ? resumed->file.info.ranges.front().seed : o.seed;
+  plan.first_sample = resumed ? resumed->file.info.ranges.front().first : o.first_sample;
+  if (std::uint64_t{plan.first_sample} + o.spp > std::numeric_limits<std::uint32_t>::max())
+    throw InputError("--first-sample " + std::to_string(plan.first_sample) + " plus --spp " + std::to_string(o.spp) +
                      " passes the last sample index (" + std::to_string(std::numeric_limits<std::uint32_t>::max()) + ")");
   if (resumed) {
     const FilmInfo& had = resumed->file.info;
     if (had.scene_hash != info.scene_hash || had.max_depth != info.max_depth)
-      throw InputError("--resume: film '" + o.resume + "' was rendered from another scene than '" + scene_path +
+      throw InputError("--resume: film '" + o.resume + "' was rendered from another scene than '" + plan.scene_path +
                        "' (its content or maximum depth differs)");
   }
+  return plan;
+}
 
-  // The reference is checked before any rendering: its size, and that the
-  // render would not repeat its random numbers.
-  const Reference reference = resolve_reference(o.reference, *scene, scene_path, o.cache_dir, false, o.quiet);
-  if (reference.loaded()) {
-    if (reference.width != scene->camera.width || reference.height != scene->camera.height)
-      throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
-                       std::to_string(reference.height) + " but the render is " +
-                       std::to_string(scene->camera.width) + "x" + std::to_string(scene->camera.height) +
-                       " (use --width/--height)");
-    if (const std::string shared = shared_random_numbers(reference.info, seed, strategy); !shared.empty())
-      throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
-  }
+// The reference is checked before any rendering: its size, and that the
+// render would not repeat its random numbers.
+Reference checked_reference(const RenderOptions& o, const RenderPlan& plan) {
+  const Scene& scene = *plan.scene;
+  const Reference reference = resolve_reference(o.reference, scene, plan.scene_path, o.cache_dir, false, o.quiet);
+  if (!reference.loaded()) return reference;
+  if (reference.width != scene.camera.width || reference.height != scene.camera.height)
+    throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
+                     std::to_string(reference.height) + " but the render is " + std::to_string(scene.camera.width) +
+                     "x" + std::to_string(scene.camera.height) + " (use --width/--height)");
+  if (const std::string shared = shared_random_numbers(reference.info, plan.seed, plan.strategy); !shared.empty())
+    throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  return reference;
+}
 
-  if (!strategy.is_unbiased() && !o.quiet)
+void note_bias(const Strategy& strategy, bool quiet) {
+  if (!strategy.is_unbiased() && !quiet)
     std::fprintf(stderr,
                  "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
                  "targets, so it omits indirect light\n",
                  strategy.to_string().c_str());
+}
 
-  SessionOptions session_options;
-  session_options.threads = o.threads;
-  session_options.publish_images = false;  // the film is read once, at the end
-  RenderSession session(session_options);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = strategy;
-  settings.seed = seed;
-  settings.target_spp = o.spp;
-  settings.first_sample = first_sample;
-  double seconds_before = 0.0;
-  if (resumed) {
-    FilmFile& file = resumed->file;
-    seconds_before = file.info.seconds;
-    const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
-    const DropCounts had_drops = file.info.dropped;
-    session.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
-  } else {
-    session.set_settings(settings);
+// A render session on the plan's film, saving it as a film file on request
+// (checkpoints, an interruption, the end).
+class FilmRender {
+ public:
+  // A resumed film is moved out of the plan into the session.
+  FilmRender(const RenderOptions& o, RenderPlan& plan) : plan_(plan), session_(session_options(o)) {
+    RenderSettings settings;
+    settings.scene = plan.scene;
+    settings.strategy = plan.strategy;
+    settings.seed = plan.seed;
+    settings.target_spp = o.spp;
+    settings.first_sample = plan.first_sample;
+    if (plan.resumed) {
+      FilmFile& file = plan.resumed->file;
+      seconds_before_ = file.info.seconds;
+      const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
+      const DropCounts had_drops = file.info.dropped;
+      session_.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
+    } else {
+      session_.set_settings(settings);
+    }
   }
 
+  RenderSession& session() { return session_; }
+
   // The film as it stands between two passes, with what it holds.
-  const auto save_film = [&](const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) {
-    FilmInfo now = info;
-    now.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
+  FilmInfo info_now(std::uint32_t spp, const DropCounts& dropped, double seconds) const {
+    FilmInfo now = plan_.info;
+    now.ranges = {SampleRange{plan_.seed, plan_.first_sample, plan_.first_sample + spp}};
     now.dropped = dropped;
-    now.seconds = seconds_before + seconds;
-    write_film_file(film_out, now, film);
+    now.seconds = seconds_before_ + seconds;
     return now;
-  };
-  const auto checkpoint = [&] {
-    session.set_paused(true);
-    const double seconds = session.stats().seconds;
+  }
+  FilmInfo save_film(const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) const {
+    const FilmInfo now = info_now(spp, dropped, seconds);
+    write_film_file(plan_.film_out, now, film);
+    return now;
+  }
+  // Pauses and saves the film; returns the spp saved (0: nothing yet).
+  std::uint32_t checkpoint() {
+    session_.set_paused(true);
+    const double seconds = session_.stats().seconds;
     std::uint32_t saved = 0;
-    session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+    session_.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
       if (spp > 0) save_film(film, spp, dropped, seconds);
       saved = spp;
     });
     return saved;
-  };
+  }
 
+ private:
+  static SessionOptions session_options(const RenderOptions& o) {
+    SessionOptions options;
+    options.threads = o.threads;
+    options.publish_images = false;  // the film is read once, at the end
+    return options;
+  }
+  const RenderPlan& plan_;
+  RenderSession session_;
+  double seconds_before_ = 0.0;
+};
+
+// Waits for the session, drawing progress, saving checkpoints and stopping on
+// SIGINT or SIGTERM. Returns kInterrupted when stopped, 0 when done; the
+// history receives the film's own estimates along the way.
+int wait_for_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& render, EstimateHistory& history) {
+  RenderSession& session = render.session();
   const StopSignals signals;
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
   using Clock = std::chrono::steady_clock;
   auto last_checkpoint = Clock::now();
-  const bool checkpoints = !film_out.empty() && o.checkpoint_seconds > 0.0;
-  EstimateHistory history;  // is the film's own estimate trustworthy?
+  const bool checkpoints = !plan.film_out.empty() && o.checkpoint_seconds > 0.0;
   std::uint32_t history_spp = 0;
   const auto note_estimate = [&](const SessionStats& now) {
     if (now.spp > history_spp && now.estimated_relmse > 0.0) history.add(now.spp, now.estimated_relmse);
@@ -276,111 +325,145 @@ int run_render(const RenderOptions& o) {
     note_estimate(session.stats());
     if (signals.stopped()) {
       if (show_progress) std::fputc('\n', stderr);
-      if (film_out.empty()) {
+      if (plan.film_out.empty()) {
         std::fprintf(stderr, "pdflab: interrupted; nothing written\n");
         return kInterrupted;
       }
-      const std::uint32_t saved = checkpoint();
+      const std::uint32_t saved = render.checkpoint();
       std::fprintf(stderr, "pdflab: interrupted at %u of %u spp; the film '%s' holds them: continue with "
-                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, film_out.c_str(), film_out.c_str(), o.spp);
+                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, plan.film_out.c_str(),
+                   plan.film_out.c_str(), o.spp);
       return kInterrupted;
     }
     if (checkpoints &&
         std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= o.checkpoint_seconds) {
-      checkpoint();
+      render.checkpoint();
       session.set_paused(false);
       last_checkpoint = Clock::now();
     }
     if (show_progress) draw_progress(session.stats(), o.spp);
   }
-  const SessionStats st = session.stats();
   if (show_progress) {
-    draw_progress(st, o.spp);
+    draw_progress(session.stats(), o.spp);
     std::fputc('\n', stderr);
   }
+  return 0;
+}
 
-  FilmInfo final_info = info;
+// What the finished render gives: the film's description as saved, its own
+// estimate and the error against the reference.
+struct RenderResult {
+  SessionStats stats;
+  FilmInfo info;
   double estimate = 0.0;
   RelMseMeasure error;
-  session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
-    if (!film_out.empty()) {
-      final_info = save_film(film, spp, dropped, st.seconds);
-    } else {
-      final_info.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
-      final_info.dropped = dropped;
-      final_info.seconds = seconds_before + st.seconds;
-    }
-    if (o.out_given) write_film_image(o.out, film, transfer, image_attributes(final_info));
-    estimate = estimated_relmse(film);
-    if (reference.loaded()) error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
+  int threads = 0;
+};
+
+RenderResult finish_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& render,
+                           const Reference& reference) {
+  RenderResult r;
+  r.stats = render.session().stats();
+  r.threads = render.session().thread_count();
+  r.info = plan.info;
+  render.session().read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+    r.info = plan.film_out.empty() ? render.info_now(spp, dropped, r.stats.seconds)
+                                   : render.save_film(film, spp, dropped, r.stats.seconds);
+    if (o.out_given) write_film_image(o.out, film, plan.transfer, image_attributes(r.info));
+    r.estimate = estimated_relmse(film);
+    if (reference.loaded()) r.error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
   });
-  history.add(static_cast<std::uint32_t>(final_info.spp()), estimate);
-  const double measured_efficiency = efficiency(error.corrected, st.seconds);
+  return r;
+}
 
-  if (!o.stats_json.empty()) {
-    nlohmann::json j;
-    j["scene"] = scene->name;
-    j["scene_file"] = scene_path;
-    j["strategy"] = strategy.to_string();
-    j["unbiased"] = strategy.is_unbiased();
-    j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
-    j["sampler"] = strategy.sobol ? "sobol" : "independent";  // +sobol
-    if (strategy.fastest) j["expanded_from"] = "fastest";
-    j["width"] = final_info.width;
-    j["height"] = final_info.height;
-    j["spp"] = final_info.spp();
-    j["seed"] = seed;
-    j["first_sample"] = first_sample;
-    j["threads"] = session.thread_count();
-    // What the speed figures came from (the images are the same bits with any).
-    j["tracer"] = std::string(packet_isa_name(best_packet_isa()));
-    j["tracer_lanes"] = packet_lanes(best_packet_isa());
-    j["seconds"] = st.seconds;
-    j["samples"] = st.samples;
-    j["samples_per_second"] = st.samples_per_second;
-    j["dropped"] = drops_json(final_info.dropped);
-    j["output"] = o.out;
-    if (!film_out.empty()) j["film"] = film_out;
-    // The film's own estimate is a lower bound: it cannot see what the samples never found.
-    j["est_relmse"] = estimate;
-    j["est_relmse_unreliable"] = history.unreliable();
-    if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(estimate, st.seconds);
-    if (reference.loaded()) {
-      j["reference"] = reference.path;
-      j["relmse"] = error.corrected;
-      j["relmse_interval"] = error.interval;
-      j["relmse_raw"] = error.raw;
-      j["reference_corrected"] = error.reference_corrected;
-      j["reference_share"] = error.reference_share();
-      j["efficiency"] = measured_efficiency;
-    }
-    write_text(o.stats_json, j.dump(2) + "\n");
+void write_render_stats(const RenderOptions& o, const RenderPlan& plan, const RenderResult& r,
+                        const Reference& reference, bool unreliable) {
+  const Strategy& strategy = plan.strategy;
+  const SessionStats& st = r.stats;
+  nlohmann::json j;
+  j["scene"] = plan.scene->name;
+  j["scene_file"] = plan.scene_path;
+  j["strategy"] = strategy.to_string();
+  j["unbiased"] = strategy.is_unbiased();
+  j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
+  j["sampler"] = strategy.sobol ? "sobol" : "independent";  // +sobol
+  if (strategy.fastest) j["expanded_from"] = "fastest";
+  j["width"] = r.info.width;
+  j["height"] = r.info.height;
+  j["spp"] = r.info.spp();
+  j["seed"] = plan.seed;
+  j["first_sample"] = plan.first_sample;
+  j["threads"] = r.threads;
+  // What the speed figures came from (the images are the same bits with any).
+  j["tracer"] = std::string(packet_isa_name(best_packet_isa()));
+  j["tracer_lanes"] = packet_lanes(best_packet_isa());
+  j["seconds"] = st.seconds;
+  j["samples"] = st.samples;
+  j["samples_per_second"] = st.samples_per_second;
+  j["dropped"] = drops_json(r.info.dropped);
+  j["output"] = o.out;
+  if (!plan.film_out.empty()) j["film"] = plan.film_out;
+  // The film's own estimate is a lower bound: it cannot see what the samples never found.
+  j["est_relmse"] = r.estimate;
+  j["est_relmse_unreliable"] = unreliable;
+  if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(r.estimate, st.seconds);
+  if (reference.loaded()) {
+    j["reference"] = reference.path;
+    j["relmse"] = r.error.corrected;
+    j["relmse_interval"] = r.error.interval;
+    j["relmse_raw"] = r.error.raw;
+    j["reference_corrected"] = r.error.reference_corrected;
+    j["reference_share"] = r.error.reference_share();
+    j["efficiency"] = efficiency(r.error.corrected, st.seconds);
   }
+  write_text(o.stats_json, j.dump(2) + "\n");
+}
 
-  const std::string target = o.out_given ? o.out : film_out;
+void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const RenderResult& r,
+                          const Reference& reference, bool unreliable) {
+  const SessionStats& st = r.stats;
+  const std::string target = o.out_given ? o.out : plan.film_out;
   std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
-              static_cast<unsigned long long>(final_info.spp()), final_info.width, final_info.height, st.seconds,
-              st.samples_per_second * 1e-6, session.thread_count(), drops_text(final_info.dropped).c_str(),
-              target.c_str());
+              static_cast<unsigned long long>(r.info.spp()), r.info.width, r.info.height, st.seconds,
+              st.samples_per_second * 1e-6, r.threads, drops_text(r.info.dropped).c_str(), target.c_str());
   if (reference.loaded()) {
     std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
                 "efficiency %.4g\n",
-                error.corrected, error.interval, reference.path.c_str(), error.raw, 100.0 * error.reference_share(),
-                error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
-                measured_efficiency);
-  } else {
-    std::printf("est. relMSE %.4g: a lower bound from the film's own variance, blind to what its samples never "
-                "found; ",
-                estimate);
-    if (strategy.is_unbiased())
-      std::printf("efficiency estimate %.4g\n", efficiency(estimate, st.seconds));
-    else
-      std::printf("no efficiency: '%s' is biased and no reference shows how much light it misses\n",
-                  strategy.to_string().c_str());
-    if (history.unreliable())
-      std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
-                  "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
+                r.error.corrected, r.error.interval, reference.path.c_str(), r.error.raw,
+                100.0 * r.error.reference_share(),
+                r.error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
+                efficiency(r.error.corrected, st.seconds));
+    return;
   }
+  std::printf("est. relMSE %.4g: a lower bound from the film's own variance, blind to what its samples never "
+              "found; ",
+              r.estimate);
+  if (plan.strategy.is_unbiased())
+    std::printf("efficiency estimate %.4g\n", efficiency(r.estimate, st.seconds));
+  else
+    std::printf("no efficiency: '%s' is biased and no reference shows how much light it misses\n",
+                plan.strategy.to_string().c_str());
+  if (unreliable)
+    std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
+                "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& o) {
+  check_render_options(o);
+  RenderPlan plan = plan_render(o);
+  const Reference reference = checked_reference(o, plan);
+  note_bias(plan.strategy, o.quiet);
+
+  FilmRender render(o, plan);
+  EstimateHistory history;  // is the film's own estimate trustworthy?
+  if (const int status = wait_for_render(o, plan, render, history); status != 0) return status;
+  const RenderResult result = finish_render(o, plan, render, reference);
+  history.add(static_cast<std::uint32_t>(result.info.spp()), result.estimate);
+
+  if (!o.stats_json.empty()) write_render_stats(o, plan, result, reference, history.unreliable());
+  print_render_summary(o, plan, result, reference, history.unreliable());
   return 0;
 }
 
