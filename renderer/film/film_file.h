@@ -13,7 +13,9 @@
 
 namespace pdflab {
 
-inline constexpr std::uint32_t kFilmFormatVersion = 1;
+// Version 2: the data's checksum continues the header's, so a header cannot be
+// put on another film's data unnoticed. Version 1 files are still read.
+inline constexpr std::uint32_t kFilmFormatVersion = 2;
 
 // Samples first .. end - 1 of the sequence of `seed`, in every pixel.
 struct SampleRange {
