@@ -49,6 +49,7 @@ Reference comparison_reference(Scene& scene, const ReferenceChoice& choice, cons
     for (std::uint64_t seed : seeds)
       if (const std::string shared = shared_random_numbers(reference.info, seed, s); !shared.empty())
         throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  if (!quiet) note_unknown_seed(reference, seeds);
   if (!quiet && !reference.has_variance())
     std::fprintf(stderr,
                  "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "

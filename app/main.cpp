@@ -109,7 +109,8 @@ void add_viewer_options(CLI::App& app, ViewerCommand& v) {
   app.add_option("--view", v.mode,
                  "Start in a view mode: image, heatmap, difference, drops, best-weight, technique-share");
   app.add_option("--reference", v.reference,
-                 "Reference image (PFM) for live error figures in the viewer (default: the cached one, if any)");
+                 "Reference (a .pfm, .exr or .film) for live error figures in the viewer (default: the cached one, "
+                 "if any)");
   app.add_option("--reference-seconds", v.make_reference_seconds, "Rendering time that Make reference starts with (30)")
       ->check(positive_number(" of seconds"));
 }
@@ -153,7 +154,8 @@ void add_render_command(CLI::App& app, RenderCommand& r) {
   render->add_option("--transfer", ro.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
       ->check(CLI::IsMember({"gamma2", "srgb"}));
   render->add_option("--reference", ro.reference,
-                     "Reference to measure against: a .pfm, or 'auto' for the cached one of this scene, size and depth");
+                     "Reference to measure against: a .pfm, .exr or .film, or 'auto' for the cached one of this "
+                     "scene, size and depth");
   add_cache_dir_option(render, ro.cache_dir);
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
   add_roulette_option(render, ro.roulette_depth);
@@ -203,6 +205,10 @@ CLI::App* add_merge_command(CLI::App& app, pdflab::MergeOptions& mo) {
   merge->add_option("--out", mo.out, "Image of the merged estimate: .exr, .pfm, .png or .hdr");
   merge->add_option("--film-out", mo.film_out, "The merged film");
   merge->add_option("--stats-json", mo.stats_json, "Also write the summary as JSON");
+  merge->add_option("--expect-spp", mo.expect_spp,
+                    "Refuse unless the films hold exactly samples [0, N) of one seed: a missing part or one that "
+                    "stopped early is named, nothing written")
+      ->check(CLI::Range(1u, 0xffffffffu));
   merge->add_option("--transfer", mo.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
       ->check(CLI::IsMember({"gamma2", "srgb"}));
   return merge;
@@ -220,7 +226,7 @@ void add_comparison_inputs(CLI::App* command, pdflab::ComparisonOptions& c, cons
       ->check(CLI::Range(1u, 1u << 30));
   command
       ->add_option("--reference", c.reference,
-                   "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
+                   "Reference: a .pfm, .exr or .film (its size sets the render size), or 'auto' for the cached one")
       ->required();
   command->add_option("--width", c.width, "With --reference auto: image width (default: the scene's)")
       ->check(CLI::Range(1, 16384));

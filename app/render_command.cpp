@@ -5,6 +5,7 @@
 #include "renderer/film/film.h"
 #include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/input_file.h"
 #include "renderer/integrator/packet.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/scene/scene_loader.h"
@@ -14,6 +15,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -80,20 +82,108 @@ void write_text(const std::string& path, const std::string& text) {
   write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
 }
 
+std::string hex_hash(std::uint64_t hash) {
+  char text[24];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+// Every seed of the film's samples, once each, in order.
+std::vector<std::uint64_t> film_seeds(const FilmInfo& info) {
+  std::vector<std::uint64_t> seeds;
+  for (const SampleRange& r : info.ranges)
+    if (std::find(seeds.begin(), seeds.end(), r.seed) == seeds.end()) seeds.push_back(r.seed);
+  return seeds;
+}
+
 // What an EXR's header says about the estimate in it.
 std::vector<std::pair<std::string, std::string>> image_attributes(const FilmInfo& info) {
-  char hash[24];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(info.scene_hash));
   std::vector<std::pair<std::string, std::string>> a = {{"pdflab.scene", info.scene_file},
-          {"pdflab.sceneHash", hash},
+          {"pdflab.sceneHash", hex_hash(info.scene_hash)},
           {"pdflab.strategy", info.strategy},
           {"pdflab.spp", std::to_string(info.spp())},
           {"pdflab.samples", info.ranges_text()},
           {"pdflab.maxDepth", std::to_string(info.max_depth)},
           {"pdflab.version", PDFLAB_VERSION}};
-  // One seed: a reference made from this image knows which random numbers to avoid.
-  if (info.ranges.size() == 1) a.emplace_back("pdflab.seed", std::to_string(info.ranges.front().seed));
+  // The seeds: a reference made from this image knows which random numbers
+  // to avoid, also when it is a merge of several ranges or seeds.
+  const std::vector<std::uint64_t> seeds = film_seeds(info);
+  std::string list;
+  for (std::uint64_t seed : seeds) {
+    if (!list.empty()) list += ',';
+    list += std::to_string(seed);
+  }
+  a.emplace_back("pdflab.seeds", list);
+  if (seeds.size() == 1) a.emplace_back("pdflab.seed", list);
   return a;
+}
+
+// The same for a PFM, which has no room for it, in its sidecar (NAME.json
+// beside NAME.pfm, where load_reference looks): a PFM kept as a reference
+// still names its seeds.
+nlohmann::json identity_json(const FilmInfo& info) {
+  nlohmann::json j;
+  j["format"] = "pdflab-render";
+  j["scene_file"] = info.scene_file;
+  j["scene_hash"] = hex_hash(info.scene_hash);
+  j["strategy"] = info.strategy;
+  j["width"] = info.width;
+  j["height"] = info.height;
+  j["max_depth"] = info.max_depth;
+  const std::vector<std::uint64_t> seeds = film_seeds(info);
+  if (!seeds.empty()) j["seed"] = seeds.front();
+  j["seeds"] = seeds;
+  j["sample_ranges"] = info.ranges_text();
+  j["spp"] = info.spp();
+  j["seconds"] = info.seconds;
+  j["version"] = PDFLAB_VERSION;
+  return j;
+}
+
+// The sidecar a PFM output gets (empty for other formats).
+std::string sidecar_of(const std::string& image) {
+  if (image.empty() || image_format_for(image) != ImageFormat::Pfm) return {};
+  return reference_paths(image).sidecar;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  if (a.empty() || b.empty()) return false;
+  std::error_code ec;
+  if (std::filesystem::equivalent(a, b, ec)) return true;
+  return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
+         std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
+}
+
+// A sidecar may replace an earlier one (pdflab's: it names a strategy), never
+// another file that happens to share the image's name: the scene itself
+// (cornell.json beside cornell.pfm) or anything else.
+void check_sidecar(const std::string& sidecar, const std::string& image, const std::string& scene) {
+  if (sidecar.empty()) return;
+  check_output_path(sidecar);
+  if (same_file(sidecar, scene))
+    throw InputError("output '" + image + "': its sidecar '" + sidecar +
+                     "' (what identifies the image) would replace the scene file; choose another name");
+  std::error_code ec;
+  if (!std::filesystem::exists(sidecar, ec)) return;
+  bool ours = false;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_input_file(sidecar, "sidecar", 1 << 20));
+    ours = j.is_object() && j.contains("strategy");
+  } catch (const std::exception&) {
+    ours = false;
+  }
+  if (!ours)
+    throw InputError("output '" + image + "': its sidecar '" + sidecar +
+                     "' would replace a file that is not a pdflab sidecar; choose another name");
+}
+
+// The image with what identifies it: attributes in an EXR, a sidecar beside a
+// PFM (unless the stats JSON is that very file, which then carries it).
+void write_identified_image(const std::string& path, const Film& film, Transfer transfer, const FilmInfo& info,
+                            const std::string& stats_json) {
+  write_film_image(path, film, transfer, image_attributes(info));
+  if (const std::string sidecar = sidecar_of(path); !sidecar.empty() && !same_file(sidecar, stats_json))
+    write_text(sidecar, identity_json(info).dump(2) + "\n");
 }
 
 nlohmann::json drops_json(const DropCounts& dropped) {
@@ -138,6 +228,9 @@ Resumed open_resume(const RenderOptions& o) {
   if (o.first_sample_given && o.first_sample != range.first)
     throw InputError("--resume: " + film + " starts at sample " + std::to_string(range.first) + ", not " +
                      std::to_string(o.first_sample));
+  if (info.spp() > o.spp)
+    throw InputError("--resume: " + film + " holds " + std::to_string(info.spp()) + " samples per pixel, more than --spp " +
+                     std::to_string(o.spp) + " asks for in all");
   if ((o.width != 0 && o.width != info.width) || (o.height != 0 && o.height != info.height))
     throw InputError("--resume: " + film + " is " + std::to_string(info.width) + "x" + std::to_string(info.height) +
                      ", not the size asked for");
@@ -159,7 +252,8 @@ void check_render_options(const RenderOptions& o) {
   const std::string film_out = o.film_out.empty() ? o.resume : o.film_out;
   if (!film_out.empty()) check_output_path(film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
-  check_distinct_outputs({o.out, film_out, o.stats_json});
+  const std::string sidecar = o.out_given ? sidecar_of(o.out) : std::string();
+  check_distinct_outputs({o.out, film_out, o.stats_json, same_file(sidecar, o.stats_json) ? "" : sidecar});
   (void)parse_transfer(o.transfer);
   if (o.threads < 0 || o.threads > 1024) throw InputError("--threads must be in 0..1024 (0: all cores)");
   if (!(o.checkpoint_seconds >= 0.0) || !std::isfinite(o.checkpoint_seconds))
@@ -178,6 +272,7 @@ struct RenderPlan {
   std::uint32_t first_sample = 0;
   std::string film_out;  // empty: no film is written
   Transfer transfer = Transfer::Gamma2;
+  std::string reference_missing;  // --reference auto found nothing: why
 };
 
 RenderPlan plan_render(const RenderOptions& o) {
@@ -223,9 +318,10 @@ RenderPlan plan_render(const RenderOptions& o) {
 
 // The reference is checked before any rendering: its size, and that the
 // render would not repeat its random numbers.
-Reference checked_reference(const RenderOptions& o, const RenderPlan& plan) {
+Reference checked_reference(const RenderOptions& o, RenderPlan& plan) {
   const Scene& scene = *plan.scene;
-  const Reference reference = resolve_reference(o.reference, scene, plan.scene_path, o.cache_dir, false, o.quiet);
+  const Reference reference =
+      resolve_reference(o.reference, scene, plan.scene_path, o.cache_dir, false, o.quiet, &plan.reference_missing);
   if (!reference.loaded()) return reference;
   if (reference.width != scene.camera.width || reference.height != scene.camera.height)
     throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
@@ -233,6 +329,7 @@ Reference checked_reference(const RenderOptions& o, const RenderPlan& plan) {
                      "x" + std::to_string(scene.camera.height) + " (use --width/--height)");
   if (const std::string shared = shared_random_numbers(reference.info, plan.seed, plan.strategy); !shared.empty())
     throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  if (!o.quiet) note_unknown_seed(reference, {plan.seed});
   return reference;
 }
 
@@ -242,6 +339,17 @@ void note_bias(const Strategy& strategy, bool quiet) {
                  "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
                  "targets, so it omits indirect light\n",
                  strategy.to_string().c_str());
+}
+
+// The film's own estimate is noted at fixed sample counts, the powers of two
+// on the way and the end, where the session stops for a moment (one short
+// pass at most for each): the same samples give the same history, and so the
+// same verdict on the estimate, however the passes fell in time. (Noted
+// whenever a poll came by, the verdict of four identical renders differed.)
+std::uint32_t next_estimate_spp(std::uint32_t spp, std::uint32_t target) {
+  std::uint64_t n = 2;
+  while (n <= spp && n < target) n *= 2;
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target));
 }
 
 // A render session on the plan's film, saving it as a film file on request
@@ -254,8 +362,9 @@ class FilmRender {
     settings.scene = plan.scene;
     settings.strategy = plan.strategy;
     settings.seed = plan.seed;
-    settings.target_spp = o.spp;
     settings.first_sample = plan.first_sample;
+    const std::uint32_t had = plan.resumed ? static_cast<std::uint32_t>(plan.resumed->file.info.spp()) : 0;
+    settings.target_spp = next_estimate_spp(had, o.spp);
     if (plan.resumed) {
       FilmFile& file = plan.resumed->file;
       seconds_before_ = file.info.seconds;
@@ -316,13 +425,27 @@ int wait_for_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& 
   using Clock = std::chrono::steady_clock;
   auto last_checkpoint = Clock::now();
   const bool checkpoints = !plan.film_out.empty() && o.checkpoint_seconds > 0.0;
-  std::uint32_t history_spp = 0;
-  const auto note_estimate = [&](const SessionStats& now) {
-    if (now.spp > history_spp && now.estimated_relmse > 0.0) history.add(now.spp, now.estimated_relmse);
-    history_spp = std::max(history_spp, now.spp);
+  std::uint32_t target = session.settings().target_spp;
+  // The progress of the whole render, not of the stretch to the next estimate.
+  const auto progress = [&] {
+    SessionStats st = session.stats();
+    st.progress = std::min(1.0, st.progress * target / o.spp);
+    return st;
   };
-  while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
-    note_estimate(session.stats());
+  for (;;) {
+    if (session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
+      std::uint32_t spp = 0;
+      double estimate = 0.0;
+      session.read_film([&](const Film& film, std::uint32_t now, const DropCounts&) {
+        spp = now;
+        estimate = estimated_relmse(film);
+      });
+      history.add(spp, estimate);
+      if (spp >= o.spp) break;
+      target = next_estimate_spp(spp, o.spp);
+      session.set_target_spp(target);
+      continue;
+    }
     if (signals.stopped()) {
       if (show_progress) std::fputc('\n', stderr);
       if (plan.film_out.empty()) {
@@ -341,10 +464,10 @@ int wait_for_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& 
       session.set_paused(false);
       last_checkpoint = Clock::now();
     }
-    if (show_progress) draw_progress(session.stats(), o.spp);
+    if (show_progress) draw_progress(progress(), o.spp);
   }
   if (show_progress) {
-    draw_progress(session.stats(), o.spp);
+    draw_progress(progress(), o.spp);
     std::fputc('\n', stderr);
   }
   return 0;
@@ -369,7 +492,7 @@ RenderResult finish_render(const RenderOptions& o, const RenderPlan& plan, FilmR
   render.session().read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
     r.info = plan.film_out.empty() ? render.info_now(spp, dropped, r.stats.seconds)
                                    : render.save_film(film, spp, dropped, r.stats.seconds);
-    if (o.out_given) write_film_image(o.out, film, plan.transfer, image_attributes(r.info));
+    if (o.out_given) write_identified_image(o.out, film, plan.transfer, r.info, o.stats_json);
     r.estimate = estimated_relmse(film);
     if (reference.loaded()) r.error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
   });
@@ -377,10 +500,11 @@ RenderResult finish_render(const RenderOptions& o, const RenderPlan& plan, FilmR
 }
 
 void write_render_stats(const RenderOptions& o, const RenderPlan& plan, const RenderResult& r,
-                        const Reference& reference, bool unreliable) {
+                        const Reference& reference, const EstimateHistory& history) {
+  const bool unreliable = history.unreliable();
   const Strategy& strategy = plan.strategy;
   const SessionStats& st = r.stats;
-  nlohmann::json j;
+  nlohmann::json j = identity_json(r.info);  // so that it can be an image's sidecar too
   j["scene"] = plan.scene->name;
   j["scene_file"] = plan.scene_path;
   j["strategy"] = strategy.to_string();
@@ -406,7 +530,13 @@ void write_render_stats(const RenderOptions& o, const RenderPlan& plan, const Re
   // The film's own estimate is a lower bound: it cannot see what the samples never found.
   j["est_relmse"] = r.estimate;
   j["est_relmse_unreliable"] = unreliable;
+  // The estimate at each power of two and at the end, which the verdict is
+  // drawn from: the same for the same samples, whatever the timing.
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& [spp, relmse_spp] : history.points()) points.push_back({spp, relmse_spp / spp});
+  j["est_relmse_history"] = points;
   if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(r.estimate, st.seconds);
+  if (!plan.reference_missing.empty()) j["reference_missing"] = plan.reference_missing;
   if (reference.loaded()) {
     j["reference"] = reference.path;
     j["relmse"] = r.error.corrected;
@@ -453,6 +583,7 @@ void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const 
 int run_render(const RenderOptions& o) {
   check_render_options(o);
   RenderPlan plan = plan_render(o);
+  if (o.out_given) check_sidecar(sidecar_of(o.out), o.out, plan.scene_path);
   const Reference reference = checked_reference(o, plan);
   note_bias(plan.strategy, o.quiet);
 
@@ -460,14 +591,15 @@ int run_render(const RenderOptions& o) {
   EstimateHistory history;  // is the film's own estimate trustworthy?
   if (const int status = wait_for_render(o, plan, render, history); status != 0) return status;
   const RenderResult result = finish_render(o, plan, render, reference);
-  history.add(static_cast<std::uint32_t>(result.info.spp()), result.estimate);
 
-  if (!o.stats_json.empty()) write_render_stats(o, plan, result, reference, history.unreliable());
+  if (!o.stats_json.empty()) write_render_stats(o, plan, result, reference, history);
   print_render_summary(o, plan, result, reference, history.unreliable());
   return 0;
 }
 
-int run_merge(const MergeOptions& o) {
+namespace {
+
+void check_merge_options(const MergeOptions& o) {
   if (o.films.empty()) throw InputError("merge: name at least one film");
   if (o.out.empty() && o.film_out.empty()) throw InputError("merge: nothing to write: give --out IMAGE, --film-out FILM or both");
   if (!o.out.empty()) {
@@ -476,42 +608,96 @@ int run_merge(const MergeOptions& o) {
   }
   if (!o.film_out.empty()) check_output_path(o.film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
-  check_distinct_outputs({o.out, o.film_out, o.stats_json});
-  const Transfer transfer = parse_transfer(o.transfer);
-
+  const std::string sidecar = sidecar_of(o.out);
+  check_distinct_outputs({o.out, o.film_out, o.stats_json, same_file(sidecar, o.stats_json) ? "" : sidecar});
+  (void)parse_transfer(o.transfer);
   for (std::size_t i = 0; i < o.films.size(); ++i)
     for (std::size_t k = 0; k < i; ++k) {
       std::error_code ec;
       if (std::filesystem::equivalent(o.films[i], o.films[k], ec))
         throw InputError("merge: film '" + o.films[i] + "' is named twice; its samples would be counted twice");
     }
+}
 
-  // Each film is checked against every one before it, so a refusal names the
-  // two files that disagree; then it is added and dropped.
-  FilmFile all = read_film_file(o.films.front());
-  std::vector<FilmInfo> seen{all.info};
-  for (std::size_t i = 1; i < o.films.size(); ++i) {
-    FilmFile next = read_film_file(o.films[i]);
+// Each film is checked against every one before it, so a refusal names the
+// two files that disagree; then it is added and dropped. `each` receives
+// every film's own description, in the order given.
+FilmFile merge_films(const std::vector<std::string>& films, std::vector<FilmInfo>& each) {
+  FilmFile all = read_film_file(films.front());
+  each = {all.info};
+  for (std::size_t i = 1; i < films.size(); ++i) {
+    FilmFile next = read_film_file(films[i]);
     for (std::size_t k = 0; k < i; ++k)
-      if (const std::string problem = merge_problem(o.films[k], seen[k], o.films[i], next.info); !problem.empty())
+      if (const std::string problem = merge_problem(films[k], each[k], films[i], next.info); !problem.empty())
         throw InputError(problem);
     all.film.add_film(next.film);
     all.info = merged_info(all.info, next.info);
-    seen.push_back(std::move(next.info));
+    each.push_back(std::move(next.info));
   }
+  return all;
+}
+
+std::string range_text(std::uint64_t seed, std::uint64_t first, std::uint64_t end) {
+  return "seed " + std::to_string(seed) + " samples [" + std::to_string(first) + ", " + std::to_string(end) + ")";
+}
+
+// --expect-spp N: the merge must be the whole of [0, N) of one seed, as a
+// fan-out of one render is. A part that failed, or stopped early and saved
+// what it had, leaves a gap; the refusal names each missing range and the
+// film that ends where it starts (a part that stopped early).
+void check_expected_samples(const MergeOptions& o, const FilmInfo& all, const std::vector<FilmInfo>& each) {
+  const std::uint32_t n = o.expect_spp;
+  const std::vector<std::uint64_t> seeds = film_seeds(all);
+  if (seeds.size() != 1)
+    throw InputError("merge: the films hold samples of " + std::to_string(seeds.size()) + " seeds (" +
+                     all.ranges_text() + "); --expect-spp " + std::to_string(n) + " expects one seed's [0, " +
+                     std::to_string(n) + ")");
+  const std::uint64_t seed = seeds.front();
+  std::string missing, beyond;
+  std::uint64_t at = 0;
+  const auto name_missing = [&](std::uint64_t first, std::uint64_t end) {
+    std::string ender;
+    for (std::size_t i = 0; i < each.size() && ender.empty(); ++i)
+      for (const SampleRange& r : each[i].ranges)
+        if (r.end == first) ender = " after '" + o.films[i] + "', which ends there";
+    if (!missing.empty()) missing += "; ";
+    missing += range_text(seed, first, end);
+    missing += ender;
+  };
+  for (const SampleRange& r : all.ranges) {  // sorted, touching ones joined (merged_info)
+    if (r.first > at && at < n) name_missing(at, std::min<std::uint64_t>(r.first, n));
+    if (r.end > n) {
+      if (!beyond.empty()) beyond += ", ";
+      beyond += range_text(seed, std::max<std::uint64_t>(r.first, n), r.end);
+    }
+    at = std::max<std::uint64_t>(at, r.end);
+  }
+  if (at < n) name_missing(at, n);
+  if (missing.empty() && beyond.empty()) return;
+  std::string why = "merge: the films hold " + std::to_string(all.spp()) + " of the " + std::to_string(n) +
+                    " samples per pixel expected (" + all.ranges_text() + ")";
+  if (!missing.empty())
+    why += "; missing " + missing + ": render the missing samples (or resume the film that stopped) and merge again";
+  if (!beyond.empty()) why += "; beyond [0, " + std::to_string(n) + "): " + beyond;
+  throw InputError(why);
+}
+
+}  // namespace
+
+int run_merge(const MergeOptions& o) {
+  check_merge_options(o);
+  const Transfer transfer = parse_transfer(o.transfer);
+  std::vector<FilmInfo> each;
+  const FilmFile all = merge_films(o.films, each);
+  if (o.expect_spp > 0) check_expected_samples(o, all.info, each);
+  if (!o.out.empty()) check_sidecar(sidecar_of(o.out), o.out, all.info.scene_file);
 
   if (!o.film_out.empty()) write_film_file(o.film_out, all.info, all.film);
-  if (!o.out.empty()) write_film_image(o.out, all.film, transfer, image_attributes(all.info));
+  if (!o.out.empty()) write_identified_image(o.out, all.film, transfer, all.info, o.stats_json);
   if (!o.stats_json.empty()) {
-    nlohmann::json j;
+    nlohmann::json j = identity_json(all.info);
     j["films"] = o.films;
-    j["scene_file"] = all.info.scene_file;
-    j["strategy"] = all.info.strategy;
-    j["width"] = all.info.width;
-    j["height"] = all.info.height;
-    j["spp"] = all.info.spp();
     j["samples"] = all.info.ranges_text();
-    j["seconds"] = all.info.seconds;
     j["dropped"] = drops_json(all.info.dropped);
     write_text(o.stats_json, j.dump(2) + "\n");
   }
