@@ -54,7 +54,7 @@ Reference comparison_reference(Scene& scene, const ReferenceChoice& choice, cons
     std::fprintf(stderr,
                  "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "
                  "(make one with pdflab reference)\n",
-                 reference.path.c_str());
+                 printable(reference.path).c_str());
   return reference;
 }
 

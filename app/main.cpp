@@ -317,7 +317,9 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab COMMAND --help' for usage.\n", e.what());
+    // CLI11 quotes what was typed: control bytes in an argument are shown, not sent to the terminal.
+    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab COMMAND --help' for usage.\n",
+                 pdflab::printable(e.what()).c_str());
     return kBadInput;
   }
   return std::nullopt;
@@ -380,7 +382,7 @@ int with_errors_reported(const std::function<int()>& command) {
     std::fprintf(stderr, "pdflab: error: %s\n", e.what());
     return kInternalFailure;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pdflab: internal error: %s\n", e.what());
+    std::fprintf(stderr, "pdflab: internal error: %s\n", pdflab::printable(e.what()).c_str());
     return kInternalFailure;
   }
 }

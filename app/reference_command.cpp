@@ -125,9 +125,9 @@ int run_reference(const ReferenceOptions& o) {
   if (!o.out.empty()) save_reference(o.out, ref);
   const std::string cached = store_cached_reference(cache_dir, key, ref);
   std::printf("reference: %s, %dx%d, depth %d, %s, seed stream %u, %u spp, %.2f s, est. relMSE %.4g -> %s%s%s\n",
-              scene->name.c_str(), ref.width, ref.height, scene->max_depth, ref.info.strategy.c_str(),
-              ref.info.seed_stream, ref.info.spp, ref.info.seconds, ref.info.estimated_relmse, cached.c_str(),
-              o.out.empty() ? "" : " and ", o.out.c_str());
+              printable(scene->name).c_str(), ref.width, ref.height, scene->max_depth, ref.info.strategy.c_str(),
+              ref.info.seed_stream, ref.info.spp, ref.info.seconds, ref.info.estimated_relmse, printable(cached).c_str(),
+              o.out.empty() ? "" : " and ", printable(o.out).c_str());
   return 0;
 }
 
@@ -137,7 +137,7 @@ Reference resolve_reference(const std::string& option, const Scene& scene, const
   if (option != "auto") return load_reference(option);
   const CacheLookup found = find_cached_reference(reference_cache_dir(cache_dir), reference_key(scene));
   if (found.status == CacheLookup::Found) {
-    if (!quiet) std::fprintf(stderr, "note: using the cached reference %s\n", found.path.c_str());
+    if (!quiet) std::fprintf(stderr, "note: using the cached reference %s\n", printable(found.path).c_str());
     return found.reference;
   }
   std::string why = found.status == CacheLookup::Damaged

@@ -454,8 +454,8 @@ int wait_for_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& 
       }
       const std::uint32_t saved = render.checkpoint();
       std::fprintf(stderr, "pdflab: interrupted at %u of %u spp; the film '%s' holds them: continue with "
-                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, plan.film_out.c_str(),
-                   plan.film_out.c_str(), o.spp);
+                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, printable(plan.film_out).c_str(),
+                   printable(plan.film_out).c_str(), o.spp);
       return kInterrupted;
     }
     if (checkpoints &&
@@ -555,11 +555,11 @@ void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const 
   const std::string target = o.out_given ? o.out : plan.film_out;
   std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
               static_cast<unsigned long long>(r.info.spp()), r.info.width, r.info.height, st.seconds,
-              st.samples_per_second * 1e-6, r.threads, drops_text(r.info.dropped).c_str(), target.c_str());
+              st.samples_per_second * 1e-6, r.threads, drops_text(r.info.dropped).c_str(), printable(target).c_str());
   if (reference.loaded()) {
     std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
                 "efficiency %.4g\n",
-                r.error.corrected, r.error.interval, reference.path.c_str(), r.error.raw,
+                r.error.corrected, r.error.interval, printable(reference.path).c_str(), r.error.raw,
                 100.0 * r.error.reference_share(),
                 r.error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
                 efficiency(r.error.corrected, st.seconds));
@@ -704,7 +704,7 @@ int run_merge(const MergeOptions& o) {
   std::printf("merged %zu films: %llu spp (%s), %dx%d, %.2f s of rendering, %s -> %s\n", o.films.size(),
               static_cast<unsigned long long>(all.info.spp()), all.info.ranges_text().c_str(), all.info.width,
               all.info.height, all.info.seconds, drops_text(all.info.dropped).c_str(),
-              (!o.out.empty() ? o.out : o.film_out).c_str());
+              printable(!o.out.empty() ? o.out : o.film_out).c_str());
   return 0;
 }
 
