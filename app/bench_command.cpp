@@ -1,7 +1,6 @@
 #include "app/bench_command.h"
 
 #include "app/measured_run.h"
-#include "app/reference_command.h"
 
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
@@ -145,120 +144,102 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   return r;
 }
 
-}  // namespace
 
-Reference comparison_reference(Scene& scene, const ReferenceChoice& choice, const std::vector<Strategy>& strategies,
-                               const std::vector<std::uint64_t>& seeds, bool quiet) {
+// What the runs need, all checked before the first: the scene (sized by the
+// reference), the strategies, the --predict family and the reference.
+struct BenchPlan {
+  std::shared_ptr<Scene> scene;
+  std::vector<Strategy> strategies;
+  Prediction prediction;
   Reference reference;
-  if (choice.option == "auto") {
-    if (choice.width) scene.camera.width = choice.width;
-    if (choice.height) scene.camera.height = choice.height;
-    check_image_size(scene.camera.width, scene.camera.height, "--width/--height");
-    scene.prepare();
-    reference = resolve_reference(choice.option, scene, choice.scene_file, choice.cache_dir, true, quiet);
-  } else {
-    if (choice.width || choice.height)
-      throw InputError("--width/--height go with --reference auto; a file's size is its own");
-    reference = load_reference(choice.option);  // InputError: unreadable, truncated, not finite
-    scene.camera.width = reference.width;
-    scene.camera.height = reference.height;
-    scene.prepare();
-  }
-  // Decorrelation: no run may repeat the reference's random numbers.
-  for (const Strategy& s : strategies)
-    for (std::uint64_t seed : seeds)
-      if (const std::string shared = shared_random_numbers(reference.info, seed, s); !shared.empty())
-        throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
-  if (!quiet && !reference.has_variance())
-    std::fprintf(stderr,
-                 "note: reference '%s' has no variance file: relmse cannot be corrected for its own noise "
-                 "(make one with pdflab reference)\n",
-                 reference.path.c_str());
-  return reference;
+};
+
+BenchPlan plan_bench(const BenchOptions& o) {
+  BenchPlan plan;
+  plan.scene = std::make_shared<Scene>(load_scene_file(o.scene));
+  plan.strategies = parse_strategy_list(o.strategies, o.roulette_depth);
+  for (const Strategy& s : plan.strategies) (void)SamplingPlan::make(s, *plan.scene);
+  plan.prediction = o.predict.empty() ? Prediction{} : plan_prediction(o.predict, plan.strategies);
+  plan.reference = comparison_reference(*plan.scene, reference_choice(o), plan.strategies, {o.seed}, o.quiet);
+  return plan;
 }
 
-int run_bench(const BenchOptions& o) {
-  if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
-    throw InputError("--seconds must be a positive number of seconds");
-  if ((o.seconds > 0) == (o.spp > 0)) throw InputError("give exactly one of --seconds (equal time) and --spp (equal samples)");
-  if (o.threads < 0) throw InputError("--threads must be >= 0");
-  check_output_path(o.csv);
-  if (!o.plot.empty()) check_output_path(o.plot);
-  if (!o.curves.empty()) check_output_path(o.curves);
-  check_distinct_outputs({o.csv, o.plot, o.curves});
-  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
-  const std::vector<Strategy> strategies = parse_strategy_list(o.strategies, o.roulette_depth);
-  for (const Strategy& s : strategies) (void)SamplingPlan::make(s, *scene);
-  const Prediction prediction = o.predict.empty() ? Prediction{} : plan_prediction(o.predict, strategies);
-  const Reference reference = comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height},
-                                                   strategies, {o.seed}, o.quiet);
+void note_biased_strategies(const std::vector<Strategy>& strategies, bool quiet) {
+  if (quiet) return;
+  for (const Strategy& s : strategies)
+    if (!s.is_unbiased())
+      std::fprintf(stderr,
+                   "note: strategy '%s' is biased (it omits indirect light): its error against the reference "
+                   "stops falling with time\n",
+                   s.to_string().c_str());
+}
 
+std::vector<Result> run_strategies(const BenchPlan& plan, const BenchOptions& o) {
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
-  if (!o.quiet)
-    for (const Strategy& s : strategies)
-      if (!s.is_unbiased())
-        std::fprintf(stderr,
-                     "note: strategy '%s' is biased (it omits indirect light): its error against the reference "
-                     "stops falling with time\n",
-                     s.to_string().c_str());
   std::vector<Result> results;
-  for (std::size_t i = 0; i < strategies.size(); ++i) {
-    const std::string prefix = "[" + std::to_string(i + 1) + "/" + std::to_string(strategies.size()) + "]";
-    results.push_back(run_one(scene, strategies[i], o, reference, prefix, show_progress));
+  for (std::size_t i = 0; i < plan.strategies.size(); ++i) {
+    char prefix[48];
+    std::snprintf(prefix, sizeof prefix, "[%zu/%zu]", i + 1, plan.strategies.size());
+    results.push_back(run_one(plan.scene, plan.strategies[i], o, plan.reference, prefix, show_progress));
   }
   if (show_progress) std::fputc('\n', stderr);
-  double predicted_best = -1.0;
-  if (prediction.pilot >= 0 && results[static_cast<std::size_t>(prediction.pilot)].spp > 0) {
-    // Replays the pilot's first samples (same seed and indices: the very paths
-    // it drew) and predicts on a grid of 0.01 and on every member's weight.
-    const Result& pilot = results[static_cast<std::size_t>(prediction.pilot)];
-    const double w = prediction.weights[static_cast<std::size_t>(prediction.pilot)];
-    std::vector<double> grid = weight_grid(101);
-    for (double m : prediction.weights)
-      if (m >= 0.0) grid.push_back(m);
-    std::sort(grid.begin(), grid.end());
-    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-    WeightPathOptions po;
-    po.seed = o.seed;
-    po.samples = std::min(pilot.spp, kPredictionSpp);
-    po.threads = o.threads;
-    const WeightPredictor predictor =
-        record_weight_paths(*scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po);
-    const double seconds_per_sample = pilot.seconds / pilot.spp;
-    WeightPrediction p = predictor.predict(reference.rgb, seconds_per_sample, kRelMseEpsilon);
-    // The cost model (weight_prediction.h): the members' measured seconds per
-    // sample against the rays per sample predicted at their weights give the
-    // fixed cost's share; the time stays anchored at the pilot's own, so that a
-    // few short, noisy runs cannot move the prediction at the pilot's weight.
-    CostFit cost_fit;
-    for (std::size_t i = 0; i < results.size(); ++i)
-      if (prediction.weights[i] >= 0.0 && results[i].spp > 0) {
-        const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
-        cost_fit.add(p.cost[static_cast<std::size_t>(g)], results[i].seconds / results[i].spp);
-      }
-    const double offset = std::clamp(cost_fit.fit(AutoWeight::kPriorOffset).offset(), 0.0, 10.0);
-    // Re-priced, not predicted again: the pilot's time per sample split with
-    // that fixed cost.
-    const CostModel model = anchored_cost_model(p.sampling_cost, seconds_per_sample, offset);
-    if (model.per_ray > 0.0) apply_cost_model(p, model);
-    predicted_best = p.best_weight();
-    for (std::size_t i = 0; i < results.size(); ++i)
-      if (prediction.weights[i] >= 0.0) {
-        results[i].weight = prediction.weights[i];
-        const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
-        results[i].predicted = p.efficiency[static_cast<std::size_t>(g)];
-        if (static_cast<std::size_t>(g) < p.largest_share.size() && std::isfinite(p.largest_share[static_cast<std::size_t>(g)]))
-          results[i].predicted_share = p.largest_share[static_cast<std::size_t>(g)];
-      }
-  }
+  return results;
+}
 
-  // Every text is built before the first is written, so only an I/O failure
-  // can leave one file without the others.
-  // est_relmse: what the film predicts without a reference; unbiased: 0 for a
-  // strategy whose pdf misses directions the integrand needs.
-  // relmse is corrected for the reference's own noise, relmse_raw is not;
-  // relmse_ci: 95% half width of relmse; ref_share: the reference's part of relmse_raw;
-  // roulette_depth: where Russian roulette starts (0: off).
+// --predict: each member's predicted efficiency into its result; returns the
+// predicted best weight (-1 without a prediction).
+double predict_members(const BenchPlan& plan, const BenchOptions& o, std::vector<Result>& results) {
+  const Prediction& prediction = plan.prediction;
+  if (prediction.pilot < 0 || results[static_cast<std::size_t>(prediction.pilot)].spp == 0) return -1.0;
+  // Replays the pilot's first samples (same seed and indices: the very paths
+  // it drew) and predicts on a grid of 0.01 and on every member's weight.
+  const Result& pilot = results[static_cast<std::size_t>(prediction.pilot)];
+  const double w = prediction.weights[static_cast<std::size_t>(prediction.pilot)];
+  std::vector<double> grid = weight_grid(101);
+  for (double m : prediction.weights)
+    if (m >= 0.0) grid.push_back(m);
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  WeightPathOptions po;
+  po.seed = o.seed;
+  po.samples = std::min(pilot.spp, kPredictionSpp);
+  po.threads = o.threads;
+  const WeightPredictor predictor =
+      record_weight_paths(*plan.scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po);
+  const double seconds_per_sample = pilot.seconds / pilot.spp;
+  WeightPrediction p = predictor.predict(plan.reference.rgb, seconds_per_sample, kRelMseEpsilon);
+  // The cost model (weight_prediction.h): the members' measured seconds per
+  // sample against the rays per sample predicted at their weights give the
+  // fixed cost's share; the time stays anchored at the pilot's own, so that a
+  // few short, noisy runs cannot move the prediction at the pilot's weight.
+  CostFit cost_fit;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (prediction.weights[i] >= 0.0 && results[i].spp > 0) {
+      const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
+      cost_fit.add(p.cost[static_cast<std::size_t>(g)], results[i].seconds / results[i].spp);
+    }
+  const double offset = std::clamp(cost_fit.fit(AutoWeight::kPriorOffset).offset(), 0.0, 10.0);
+  // Re-priced, not predicted again: the pilot's time per sample split with
+  // that fixed cost.
+  const CostModel model = anchored_cost_model(p.sampling_cost, seconds_per_sample, offset);
+  if (model.per_ray > 0.0) apply_cost_model(p, model);
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (prediction.weights[i] >= 0.0) {
+      results[i].weight = prediction.weights[i];
+      const auto g = std::lower_bound(grid.begin(), grid.end(), prediction.weights[i]) - grid.begin();
+      results[i].predicted = p.efficiency[static_cast<std::size_t>(g)];
+      if (static_cast<std::size_t>(g) < p.largest_share.size() && std::isfinite(p.largest_share[static_cast<std::size_t>(g)]))
+        results[i].predicted_share = p.largest_share[static_cast<std::size_t>(g)];
+    }
+  return p.best_weight();
+}
+
+// est_relmse: what the film predicts without a reference; unbiased: 0 for a
+// strategy whose pdf misses directions the integrand needs.
+// relmse is corrected for the reference's own noise, relmse_raw is not;
+// relmse_ci: 95% half width of relmse; ref_share: the reference's part of relmse_raw;
+// roulette_depth: where Russian roulette starts (0: off).
+std::string results_csv(const std::vector<Result>& results) {
   std::string csv =
       "strategy,spp,seconds,rmse,relmse,efficiency,samples_per_second,dropped,est_relmse,unbiased,relmse_raw,"
       "relmse_ci,ref_share,roulette_depth,weight,predicted_efficiency,predicted_largest_share\n";
@@ -271,44 +252,56 @@ int run_bench(const BenchOptions& o) {
     csv += csv_field(r.strategy.to_string()) + line + optional_number(r.weight) + "," + optional_number(r.predicted) + "," +
            optional_number(r.predicted_share) + "\n";
   }
+  return csv;
+}
 
-  std::string curves;
-  if (!o.curves.empty()) {
-    curves = "strategy,spp,seconds,rmse,relmse,relmse_raw\n";
-    for (const Result& r : results)
-      for (const Checkpoint& k : r.curve) {
-        std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse, k.relmse_raw);
-        curves += csv_field(r.strategy.to_string()) + line;
-      }
-  }
-
-  std::string plot;
-  if (!o.plot.empty()) {
-    std::vector<PlotSeries> series;
-    for (const Result& r : results) {
-      PlotSeries s;
-      s.label = r.strategy.to_string() + (r.strategy.is_unbiased() ? "" : " (biased)");
-      for (const Checkpoint& k : r.curve) {
-        s.x.push_back(k.seconds);
-        s.y.push_back(k.rmse);
-      }
-      series.push_back(std::move(s));
+std::string curves_csv(const std::vector<Result>& results) {
+  std::string curves = "strategy,spp,seconds,rmse,relmse,relmse_raw\n";
+  char line[512];
+  for (const Result& r : results)
+    for (const Checkpoint& k : r.curve) {
+      std::snprintf(line, sizeof line, ",%u,%.6g,%.6g,%.6g,%.6g\n", k.spp, k.seconds, k.rmse, k.relmse, k.relmse_raw);
+      curves += csv_field(r.strategy.to_string()) + line;
     }
-    PlotOptions po;
-    po.title = "RMSE against time: " + scene->name;
-    po.x_label = "seconds";
-    po.y_label = "RMSE vs reference";
-    po.guide_slope = -0.5;
-    po.guide_label = "1/sqrt(N)";
-    po.width = 900;
-    po.height = 520;
-    plot = loglog_svg(series, po);
+  return curves;
+}
+
+std::string rmse_plot(const std::vector<Result>& results, const std::string& scene_name) {
+  std::vector<PlotSeries> series;
+  for (const Result& r : results) {
+    PlotSeries s;
+    s.label = r.strategy.to_string() + (r.strategy.is_unbiased() ? "" : " (biased)");
+    for (const Checkpoint& k : r.curve) {
+      s.x.push_back(k.seconds);
+      s.y.push_back(k.rmse);
+    }
+    series.push_back(std::move(s));
   }
+  PlotOptions po;
+  po.title = "RMSE against time: " + scene_name;
+  po.x_label = "seconds";
+  po.y_label = "RMSE vs reference";
+  po.guide_slope = -0.5;
+  po.guide_label = "1/sqrt(N)";
+  po.width = 900;
+  po.height = 520;
+  return loglog_svg(series, po);
+}
+
+// Every text is built before the first is written, so only an I/O failure
+// can leave one file without the others.
+void write_bench_files(const BenchOptions& o, const std::vector<Result>& results, const std::string& scene_name) {
+  const std::string csv = results_csv(results);
+  const std::string curves = o.curves.empty() ? std::string() : curves_csv(results);
+  const std::string plot = o.plot.empty() ? std::string() : rmse_plot(results, scene_name);
   write_text(o.csv, csv);
   if (!o.curves.empty()) write_text(o.curves, curves);
   if (!o.plot.empty()) write_text(o.plot, plot);
+}
 
-  // The table: efficiency relative to the first strategy says which PDF wins.
+// The table: efficiency relative to the first strategy says which PDF wins.
+void print_bench_table(const BenchPlan& plan, const std::vector<Result>& results, double predicted_best) {
+  const Prediction& prediction = plan.prediction;
   const bool predicted = prediction.pilot >= 0;
   std::printf("%-36s %7s %8s %10s %10s %9s %10s %7s %10s %11s %8s %9s %8s%s\n", "strategy", "spp", "seconds", "rmse",
               "relmse", "+-", "raw", "ref %", "est relmse", "efficiency", "vs first", "Msamp/s", "dropped",
@@ -329,19 +322,33 @@ int run_bench(const BenchOptions& o) {
               "reference's own noise as a share of raw; efficiency = 1 / (relMSE * seconds); est relmse: the film's "
               "own prediction, no reference\n",
               kRelMseEpsilon,
-              reference.has_variance() ? "minus the reference's own noise" : "(the reference has no variance: uncorrected)");
+              plan.reference.has_variance() ? "minus the reference's own noise"
+                                            : "(the reference has no variance: uncorrected)");
   if (predicted)
     std::printf("predicted: efficiency of each mixture of %s and %s from the paths of %s (%s's share %.3g); predicted "
                 "best share of %s: %.3g\n",
                 prediction.pair.a.c_str(), prediction.pair.b.c_str(),
-                strategies[static_cast<std::size_t>(prediction.pilot)].to_string().c_str(), prediction.pair.a.c_str(),
-                prediction.weights[static_cast<std::size_t>(prediction.pilot)], prediction.pair.a.c_str(), predicted_best);
+                plan.strategies[static_cast<std::size_t>(prediction.pilot)].to_string().c_str(),
+                prediction.pair.a.c_str(), prediction.weights[static_cast<std::size_t>(prediction.pilot)],
+                prediction.pair.a.c_str(), predicted_best);
   bool dominated = false;
   for (const Result& r : results) dominated = dominated || r.predicted_share > kDominantShare;
   if (dominated)
     std::printf("*: one path carries more than %.0f%% of that prediction's second moment: there the moment is infinite or "
                 "carried by paths too rare for the replay, and the predicted efficiency is likely too high\n",
                 100.0 * kDominantShare);
+}
+
+}  // namespace
+
+int run_bench(const BenchOptions& o) {
+  check_comparison_options(o, {o.curves});
+  const BenchPlan plan = plan_bench(o);
+  note_biased_strategies(plan.strategies, o.quiet);
+  std::vector<Result> results = run_strategies(plan, o);
+  const double predicted_best = predict_members(plan, o, results);
+  write_bench_files(o, results, plan.scene->name);
+  print_bench_table(plan, results, predicted_best);
   return 0;
 }
 

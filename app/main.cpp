@@ -16,6 +16,8 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <functional>
+#include <optional>
 
 #ifdef PDFLAB_HAVE_VIEWER
 #include "app/viewer.h"
@@ -47,26 +49,6 @@ CLI::Validator positive_number(const std::string& what) {
       "NUMBER");
 }
 
-// Every command that reads or writes references takes the cache folder the same way.
-void add_cache_dir_option(CLI::App* command, std::string& cache_dir) {
-  command->add_option("--cache-dir", cache_dir,
-                      "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, else $XDG_CACHE_HOME/pdflab/references)");
-}
-
-// A headless comparison's reference (bench, sweep): the file or the cache, and
-// the size to look it up at.
-void add_comparison_reference_options(CLI::App* command, std::string& reference, int& width, int& height,
-                                      std::string& cache_dir) {
-  command->add_option("--reference", reference,
-                      "Reference: a .pfm (its size sets the render size), or 'auto' for the cached one")
-      ->required();
-  command->add_option("--width", width, "With --reference auto: image width (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  command->add_option("--height", height, "With --reference auto: image height (default: the scene's)")
-      ->check(CLI::Range(1, 16384));
-  add_cache_dir_option(command, cache_dir);
-}
-
 CLI::Validator non_negative_integer() {
   return CLI::Validator(
       [](std::string& value) {
@@ -80,6 +62,12 @@ CLI::Validator non_negative_integer() {
       "UINT64");
 }
 
+// Every command that reads or writes references takes the cache folder the same way.
+void add_cache_dir_option(CLI::App* command, std::string& cache_dir) {
+  command->add_option("--cache-dir", cache_dir,
+                      "Reference cache folder (default: $PDFLAB_REFERENCE_CACHE, else $XDG_CACHE_HOME/pdflab/references)");
+}
+
 // --rr or --rr=D: Russian roulette in every strategy the command renders.
 void add_roulette_option(CLI::App* command, int& depth) {
   command
@@ -89,55 +77,68 @@ void add_roulette_option(CLI::App* command, int& depth) {
       ->check(CLI::Range(1, pdflab::kMaxRouletteDepth));
 }
 
-}  // namespace
+void add_threads_option(CLI::App* command, int& threads) {
+  command->add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+}
 
-int main(int argc, char** argv) {
-  CLI::App app{"pdflab: a laboratory for importance sampling in path tracing"};
-  app.set_version_flag("--version", std::string(PDFLAB_VERSION));
-  app.require_subcommand(0, 1);
+// The viewer: pdflab without a command. Its options stay apart from
+// ViewerOptions so that a build without the viewer parses them too.
+struct ViewerCommand {
+  std::string scene, strategy = "mix:cosine=0.5,light=0.5", screenshot, reference, resume, mode;
+  std::uint32_t spp = 0;
+  float ui_scale = 1.0f;
+  bool presentation = false, auto_weight = false;
+  double make_reference_seconds = 0.0;
+  CLI::Option* strategy_option = nullptr;
+};
 
-  // The viewer's options (no subcommand).
-  std::string view_scene, view_strategy = "mix:cosine=0.5,light=0.5", screenshot;
-  std::uint32_t view_spp = 0;
-  app.add_option("--scene", view_scene, "Scene file (default: the book's Cornell box)");
-  CLI::Option* view_strategy_option = app.add_option("--strategy", view_strategy, "Sampling strategy (below)");
+void add_viewer_options(CLI::App& app, ViewerCommand& v) {
+  app.add_option("--scene", v.scene, "Scene file (default: the book's Cornell box)");
+  v.strategy_option = app.add_option("--strategy", v.strategy, "Sampling strategy (below)");
   app.footer(pdflab::strategy_help());
-  app.add_option("--spp", view_spp, "With --screenshot: samples per pixel to render before saving")
+  app.add_option("--spp", v.spp, "With --screenshot: samples per pixel to render before saving")
       ->check(CLI::Range(1u, 1u << 30));
-  app.add_option("--screenshot", screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
-  std::string view_reference, view_resume;
-  app.add_option("--resume", view_resume,
+  app.add_option("--screenshot", v.screenshot, "Render until --spp, save this PNG (plus PFM and JSON), exit");
+  app.add_option("--resume", v.resume,
                  "Continue a film file (from render --film-out or the viewer's Ctrl+S) with its scene and settings");
-  float view_ui_scale = 1.0f;
-  bool view_presentation = false;
-  bool view_auto_weight = false;
-  std::string view_mode;
-  app.add_option("--ui-scale", view_ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
+  app.add_option("--ui-scale", v.ui_scale, "Scale of the panels and their text, e.g. 1.5 for a projector")
       ->check(CLI::Range(0.5f, 4.0f));
-  app.add_flag("--presentation", view_presentation, "Start in presentation mode: full screen, no panel (F11 leaves)");
-  app.add_flag("--auto-weight", view_auto_weight,
+  app.add_flag("--presentation", v.presentation, "Start in presentation mode: full screen, no panel (F11 leaves)");
+  app.add_flag("--auto-weight", v.auto_weight,
                "Start with auto weight: a two-technique mixture's w moves between passes to the predicted best");
-  app.add_option("--view", view_mode,
+  app.add_option("--view", v.mode,
                  "Start in a view mode: image, heatmap, difference, drops, best-weight, technique-share");
-  app.add_option("--reference", view_reference,
-                 "Reference image (PFM) for live error figures in the viewer (default: the cached one, if any)");
-  double view_make_seconds = 0.0;
-  app.add_option("--reference-seconds", view_make_seconds, "Rendering time that Make reference starts with (30)")
+  app.add_option("--reference", v.reference,
+                 "Reference (a .pfm, .exr or .film) for live error figures in the viewer (default: the cached one, "
+                 "if any)");
+  app.add_option("--reference-seconds", v.make_reference_seconds, "Rendering time that Make reference starts with (30)")
       ->check(positive_number(" of seconds"));
+}
 
-  pdflab::RenderOptions ro;
-  CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
+// `render`, with what was typed and what was left to its default.
+struct RenderCommand {
+  pdflab::RenderOptions options;
+  CLI::App* app = nullptr;
+  CLI::Option *scene = nullptr, *strategy = nullptr, *spp = nullptr, *out = nullptr, *seed = nullptr,
+              *first_sample = nullptr;
+};
+
+void add_render_command(CLI::App& app, RenderCommand& r) {
+  pdflab::RenderOptions& ro = r.options;
+  CLI::App* render = r.app = app.add_subcommand("render", "Render headlessly to an image file");
   render->footer(pdflab::strategy_help());
-  CLI::Option* scene_option = render->add_option("--scene", ro.scene, "Scene file (JSON); with --resume, default: the film's");
-  CLI::Option* strategy_option = render->add_option("--strategy", ro.strategy,
-                     "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5; with --resume, default: the film's");
-  CLI::Option* spp_option =
-      render->add_option("--spp", ro.spp, "Samples per pixel (with --resume: in all, those in the film included)")
-          ->check(CLI::Range(1u, 1u << 30));
-  CLI::Option* out_option = render->add_option("--out", ro.out, "Output image: .png (tone-mapped), .pfm (linear), .hdr, .exr (linear, with variance and count layers)");
-  CLI::Option* seed_option = render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)")
-      ->check(non_negative_integer());
-  CLI::Option* first_option =
+  r.scene = render->add_option("--scene", ro.scene, "Scene file (JSON); with --resume, default: the film's");
+  r.strategy = render->add_option(
+      "--strategy", ro.strategy,
+      "Sampling strategy, e.g. cosine, light, mix:cosine=0.5,light=0.5; with --resume, default: the film's");
+  r.spp = render->add_option("--spp", ro.spp, "Samples per pixel (with --resume: in all, those in the film included)")
+              ->check(CLI::Range(1u, 1u << 30));
+  r.out = render->add_option("--out", ro.out,
+                             "Output image: .png (tone-mapped), .pfm (linear), .hdr, .exr (linear, with variance "
+                             "and count layers)");
+  r.seed = render->add_option("--seed", ro.seed, "Random seed (same seed, same image, any thread count)")
+               ->check(non_negative_integer());
+  r.first_sample =
       render->add_option("--first-sample", ro.first_sample,
                          "Index of the first sample of each pixel (default 0): renders of disjoint ranges merge")
           ->check(CLI::Range(0u, 0xffffffffu));
@@ -146,19 +147,34 @@ int main(int argc, char** argv) {
   render->add_option("--checkpoint-seconds", ro.checkpoint_seconds,
                      "With a film file: save it this often while rendering (default 60; 0: only at the end)")
       ->check(CLI::Range(0.0, 1e9));
-  render->add_option("--threads", ro.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  add_threads_option(render, ro.threads);
   render->add_option("--width", ro.width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   render->add_option("--height", ro.height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   render->add_option("--stats-json", ro.stats_json, "Also write the summary as JSON");
   render->add_option("--transfer", ro.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
       ->check(CLI::IsMember({"gamma2", "srgb"}));
   render->add_option("--reference", ro.reference,
-                     "Reference to measure against: a .pfm, or 'auto' for the cached one of this scene, size and depth");
+                     "Reference to measure against: a .pfm, .exr or .film, or 'auto' for the cached one of this "
+                     "scene, size and depth");
   add_cache_dir_option(render, ro.cache_dir);
   render->add_flag("--quiet", ro.quiet, "No progress bar or notes");
   add_roulette_option(render, ro.roulette_depth);
+}
 
-  pdflab::ReferenceOptions fo;
+// What render needs to know about the command line beyond the values: which
+// options were typed (with --resume the others default to the film's).
+pdflab::RenderOptions typed_render_options(const RenderCommand& r) {
+  pdflab::RenderOptions o = r.options;
+  o.scene_given = r.scene->count() > 0;
+  o.strategy_given = r.strategy->count() > 0;
+  o.spp_given = r.spp->count() > 0;
+  o.out_given = r.out->count() > 0;
+  o.seed_given = r.seed->count() > 0;
+  o.first_sample_given = r.first_sample->count() > 0;
+  return o;
+}
+
+CLI::App* add_reference_command(CLI::App& app, pdflab::ReferenceOptions& fo) {
   CLI::App* reference = app.add_subcommand(
       "reference", "Render a converged reference (unbiased, reserved seeds) into the cache, and --out if given");
   reference->add_option("--scene", fo.scene, "Scene file (JSON)")->required();
@@ -177,57 +193,86 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0u, 1u << 30));
   reference->add_option("--out", fo.out, "Also write the reference here (.pfm, with .var.pfm and .json beside it)");
   add_cache_dir_option(reference, fo.cache_dir);
-  reference->add_option("--threads", fo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  add_threads_option(reference, fo.threads);
   reference->add_flag("--quiet", fo.quiet, "No progress bar or notes");
   add_roulette_option(reference, fo.roulette_depth);
+  return reference;
+}
 
-  pdflab::MergeOptions mo;
+CLI::App* add_merge_command(CLI::App& app, pdflab::MergeOptions& mo) {
   CLI::App* merge = app.add_subcommand("merge", "Add films of one scene and settings with disjoint sample ranges");
   merge->add_option("films", mo.films, "Film files (from render --film-out)")->required();
   merge->add_option("--out", mo.out, "Image of the merged estimate: .exr, .pfm, .png or .hdr");
   merge->add_option("--film-out", mo.film_out, "The merged film");
   merge->add_option("--stats-json", mo.stats_json, "Also write the summary as JSON");
+  merge->add_option("--expect-spp", mo.expect_spp,
+                    "Refuse unless the films hold exactly samples [0, N) of one seed: a missing part or one that "
+                    "stopped early is named, nothing written")
+      ->check(CLI::Range(1u, 0xffffffffu));
   merge->add_option("--transfer", mo.transfer, "PNG transfer curve: gamma2 (the book's) or srgb")
       ->check(CLI::IsMember({"gamma2", "srgb"}));
+  return merge;
+}
 
-  pdflab::BenchOptions bo;
+// What bench and sweep share (ComparisonOptions), in three groups placed
+// among each command's own options: how long each run is and what it is
+// measured against; the CSV and the plot; the seed and the threads.
+void add_comparison_inputs(CLI::App* command, pdflab::ComparisonOptions& c, const std::string& per_run) {
+  // CLI::PositiveNumber would print DBL_MAX in its message and let "nan" through to the
+  // "exactly one of" check; say plainly what is wrong instead.
+  command->add_option("--seconds", c.seconds, "Render time per " + per_run + " (equal time)")
+      ->check(positive_number(" of seconds"));
+  command->add_option("--spp", c.spp, "Samples per pixel per " + per_run + " (equal samples)")
+      ->check(CLI::Range(1u, 1u << 30));
+  command
+      ->add_option("--reference", c.reference,
+                   "Reference: a .pfm, .exr or .film (its size sets the render size), or 'auto' for the cached one")
+      ->required();
+  command->add_option("--width", c.width, "With --reference auto: image width (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  command->add_option("--height", c.height, "With --reference auto: image height (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  add_cache_dir_option(command, c.cache_dir);
+}
+
+void add_comparison_outputs(CLI::App* command, pdflab::ComparisonOptions& c, const std::string& csv_help,
+                            const std::string& plot_help) {
+  command->add_option("--csv", c.csv, csv_help)->required();
+  command->add_option("--plot", c.plot, plot_help);
+}
+
+void add_seed_and_threads(CLI::App* command, pdflab::ComparisonOptions& c, const std::string& seed_help) {
+  command->add_option("--seed", c.seed, seed_help)->check(non_negative_integer());
+  add_threads_option(command, c.threads);
+}
+
+CLI::App* add_bench_command(CLI::App& app, pdflab::BenchOptions& bo) {
   CLI::App* bench = app.add_subcommand("bench", "Compare strategies at equal time (or spp) against a reference");
   bench->add_option("--scene", bo.scene, "Scene file (JSON)")->required();
   bench->add_option("--strategies", bo.strategies, "Strategies separated by ';'")->required();
-  // CLI::PositiveNumber would print DBL_MAX in its message and let "nan" through to the
-  // "exactly one of" check; say plainly what is wrong instead.
-  bench->add_option("--seconds", bo.seconds, "Render time per strategy (equal time)")
-      ->check(positive_number(" of seconds"));
-  bench->add_option("--spp", bo.spp, "Samples per pixel per strategy (equal samples)")->check(CLI::Range(1u, 1u << 30));
-  add_comparison_reference_options(bench, bo.reference, bo.width, bo.height, bo.cache_dir);
-  bench->add_option("--csv", bo.csv, "Results table as CSV")->required();
-  bench->add_option("--plot", bo.plot, "Log-log plot of RMSE against time (SVG)");
+  add_comparison_inputs(bench, bo, "strategy");
+  add_comparison_outputs(bench, bo, "Results table as CSV", "Log-log plot of RMSE against time (SVG)");
   bench->add_option("--curves", bo.curves, "Every checkpoint of every strategy as CSV");
   bench->add_option("--predict", bo.predict,
                     "A,B: predict each mixture of A and B's efficiency from the paths of the one nearest 0.5");
-  bench->add_option("--seed", bo.seed, "Random seed (default 2; use one the reference was not rendered with)")
-      ->check(non_negative_integer());
-  bench->add_option("--threads", bo.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  add_seed_and_threads(bench, bo, "Random seed (default 2; use one the reference was not rendered with)");
   bench->add_flag("--quiet", bo.quiet, "No progress line");
   add_roulette_option(bench, bo.roulette_depth);
+  return bench;
+}
 
-  pdflab::SweepOptions so;
+CLI::App* add_sweep_command(CLI::App& app, pdflab::SweepOptions& so) {
   CLI::App* sweep =
       app.add_subcommand("sweep", "Efficiency against the mixture weight of two techniques, at equal time, over seeds");
   sweep->add_option("--scene", so.scene, "Scene file (JSON)")->required();
   sweep->add_option("--vary", so.vary, "The two techniques A,B whose shares are swept (e.g. cosine,light)")->required();
   sweep->add_option("--weights", so.weights, "A's share of the pair as LO:HI:STEP (e.g. 0.1:0.9:0.1)")->required();
   sweep->add_option("--strategy", so.strategy, "Base mixture: the other techniques keep their weights");
-  sweep->add_option("--seconds", so.seconds, "Render time per run (equal time)")->check(positive_number(" of seconds"));
-  sweep->add_option("--spp", so.spp, "Samples per pixel per run (equal samples)")->check(CLI::Range(1u, 1u << 30));
-  add_comparison_reference_options(sweep, so.reference, so.width, so.height, so.cache_dir);
+  add_comparison_inputs(sweep, so, "run");
   sweep->add_option("--seeds", so.seeds, "Runs per weight, for the intervals (default 3)")->check(CLI::Range(1, 1000));
-  sweep->add_option("--seed", so.seed, "First seed (default 2; use one the reference was not rendered with)")
-      ->check(non_negative_integer());
-  sweep->add_option("--csv", so.csv, "One row per weight (CSV)")->required();
-  sweep->add_option("--plot", so.plot, "Efficiency against weight, best weight marked (SVG)");
+  add_comparison_outputs(sweep, so, "One row per weight (CSV)", "Efficiency against weight, best weight marked (SVG)");
   sweep->add_option("--map", so.map, "Each pixel's predicted best weight, blue (0) to red (1) (PNG)");
-  sweep->add_option("--threads", so.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  add_seed_and_threads(sweep, so, "First seed (default 2; use one the reference was not rendered with)");
   sweep->add_flag("--quiet", so.quiet, "No progress");
   add_roulette_option(sweep, so.roulette_depth);
   sweep->add_flag("--auto", so.auto_weight,
@@ -235,7 +280,34 @@ int main(int argc, char** argv) {
   sweep->add_flag("--cpu-time", so.cpu_time,
                   "Price each run by its CPU time rather than the wall clock (runs still stop by the wall clock); "
                   "for a machine shared with other work");
+  return sweep;
+}
 
+// The whole command line: the viewer's options and each command's.
+struct CommandLine {
+  ViewerCommand viewer;
+  RenderCommand render;
+  pdflab::ReferenceOptions reference;
+  pdflab::MergeOptions merge;
+  pdflab::BenchOptions bench;
+  pdflab::SweepOptions sweep;
+  CLI::App *reference_app = nullptr, *merge_app = nullptr, *bench_app = nullptr, *sweep_app = nullptr;
+};
+
+void define_command_line(CLI::App& app, CommandLine& c) {
+  app.set_version_flag("--version", std::string(PDFLAB_VERSION));
+  app.require_subcommand(0, 1);
+  add_viewer_options(app, c.viewer);
+  add_render_command(app, c.render);
+  c.reference_app = add_reference_command(app, c.reference);
+  c.merge_app = add_merge_command(app, c.merge);
+  c.bench_app = add_bench_command(app, c.bench);
+  c.sweep_app = add_sweep_command(app, c.sweep);
+}
+
+// The exit status when parsing ends the run (help, version, a parse error);
+// nothing when a command is to run.
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -245,64 +317,82 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab COMMAND --help' for usage.\n", e.what());
+    // CLI11 quotes what was typed: control bytes in an argument are shown, not sent to the terminal.
+    std::fprintf(stderr, "pdflab: error: %s\nRun 'pdflab --help' or 'pdflab COMMAND --help' for usage.\n",
+                 pdflab::printable(e.what()).c_str());
     return kBadInput;
   }
+  return std::nullopt;
+}
 
-  try {
-    if (render->parsed()) {
-      ro.scene_given = scene_option->count() > 0;
-      ro.strategy_given = strategy_option->count() > 0;
-      ro.spp_given = spp_option->count() > 0;
-      ro.out_given = out_option->count() > 0;
-      ro.seed_given = seed_option->count() > 0;
-      ro.first_sample_given = first_option->count() > 0;
-      return pdflab::run_render(ro);
-    }
-    if (merge->parsed()) return pdflab::run_merge(mo);
-    if (bench->parsed()) return pdflab::run_bench(bo);
-    if (reference->parsed()) return pdflab::run_reference(fo);
-    if (sweep->parsed()) return pdflab::run_sweep(so);
 #ifdef PDFLAB_HAVE_VIEWER
-    pdflab::ViewerOptions vo;
-    vo.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;
-    vo.strategy = view_strategy;
-    vo.spp = view_spp;
-    vo.screenshot = screenshot;
-    vo.reference = view_reference;
-    vo.resume = view_resume;
-    if (!view_resume.empty()) {
-      // The film names its scene and strategy; given again, they must match it.
-      const pdflab::FilmFile film = pdflab::read_film_file(view_resume);
-      if (view_scene.empty()) vo.scene = film.info.scene_file;
-      if (view_strategy_option->count() == 0) vo.strategy = film.info.strategy;
-    }
-    vo.ui_scale = view_ui_scale;
-    vo.presentation = view_presentation;
-    vo.auto_weight = view_auto_weight;
-    vo.view = view_mode;
-    vo.make_reference_seconds = view_make_seconds;
-    return pdflab::run_viewer(vo);
+int run_viewer_command(const ViewerCommand& v) {
+  pdflab::ViewerOptions vo;
+  vo.scene = v.scene.empty() ? pdflab::default_scene_path() : v.scene;
+  vo.strategy = v.strategy;
+  vo.spp = v.spp;
+  vo.screenshot = v.screenshot;
+  vo.reference = v.reference;
+  vo.resume = v.resume;
+  if (!v.resume.empty()) {
+    // The film names its scene and strategy; given again, they must match it.
+    const pdflab::FilmFile film = pdflab::read_film_file(v.resume);
+    if (v.scene.empty()) vo.scene = film.info.scene_file;
+    if (v.strategy_option->count() == 0) vo.strategy = film.info.strategy;
+  }
+  vo.ui_scale = v.ui_scale;
+  vo.presentation = v.presentation;
+  vo.auto_weight = v.auto_weight;
+  vo.view = v.mode;
+  vo.make_reference_seconds = v.make_reference_seconds;
+  return pdflab::run_viewer(vo);
+}
 #else
-    // Built without the viewer: render the default scene headlessly instead.
-    (void)view_strategy_option;
-    pdflab::RenderOptions fallback;
-    fallback.scene = view_scene.empty() ? pdflab::default_scene_path() : view_scene;
-    fallback.strategy = view_strategy;
-    fallback.spp = view_spp ? view_spp : 64;
-    fallback.out = screenshot.empty() ? "pdflab.png" : screenshot;
-    const int status = pdflab::run_render(fallback);
-    std::printf("pdflab was built without the viewer; the image is at %s\n",
-                std::filesystem::absolute(fallback.out).c_str());
-    return status;
+// Built without the viewer: render the default scene headlessly instead.
+int run_viewer_command(const ViewerCommand& v) {
+  pdflab::RenderOptions fallback;
+  fallback.scene = v.scene.empty() ? pdflab::default_scene_path() : v.scene;
+  fallback.strategy = v.strategy;
+  fallback.spp = v.spp ? v.spp : 64;
+  fallback.out = v.screenshot.empty() ? "pdflab.png" : v.screenshot;
+  const int status = pdflab::run_render(fallback);
+  std::printf("pdflab was built without the viewer; the image is at %s\n",
+              std::filesystem::absolute(fallback.out).c_str());
+  return status;
+}
 #endif
+
+int run_chosen_command(const CommandLine& c) {
+  if (c.render.app->parsed()) return pdflab::run_render(typed_render_options(c.render));
+  if (c.merge_app->parsed()) return pdflab::run_merge(c.merge);
+  if (c.bench_app->parsed()) return pdflab::run_bench(c.bench);
+  if (c.reference_app->parsed()) return pdflab::run_reference(c.reference);
+  if (c.sweep_app->parsed()) return pdflab::run_sweep(c.sweep);
+  return run_viewer_command(c.viewer);
+}
+
+// Bad input is one message and status 2; a failure of the machine (a full
+// disk) or of pdflab itself is status 1.
+int with_errors_reported(const std::function<int()>& command) {
+  try {
+    return command();
   } catch (const pdflab::InputError& e) {
     return report_input_error(e.what());
   } catch (const pdflab::IoError& e) {
     std::fprintf(stderr, "pdflab: error: %s\n", e.what());
     return kInternalFailure;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pdflab: internal error: %s\n", e.what());
+    std::fprintf(stderr, "pdflab: internal error: %s\n", pdflab::printable(e.what()).c_str());
     return kInternalFailure;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"pdflab: a laboratory for importance sampling in path tracing"};
+  CommandLine command_line;
+  define_command_line(app, command_line);
+  if (const std::optional<int> status = parse_command_line(app, argc, argv)) return *status;
+  return with_errors_reported([&] { return run_chosen_command(command_line); });
 }

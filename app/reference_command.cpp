@@ -36,6 +36,46 @@ void draw_progress(const ReferenceProgress& p, const SessionStats& st) {
 
 }  // namespace
 
+void note_unknown_seed(const Reference& reference, const std::vector<std::uint64_t>& seeds) {
+  if (!reference.loaded() || reference.info.seed_known) return;
+  std::string list;
+  for (std::uint64_t seed : seeds) {
+    if (!list.empty()) list += ", ";
+    list += std::to_string(seed);
+  }
+  std::fprintf(stderr,
+               "note: reference '%s' does not record its seed (a PFM without its sidecar '%s'): were it rendered with "
+               "seed %s, it would share random numbers with this render and the error would look too small\n",
+               printable(reference.path).c_str(), printable(reference_paths(reference.path).sidecar).c_str(),
+               list.c_str());
+}
+
+void check_cache_dir(const std::string& cache_dir) {
+  namespace fs = std::filesystem;
+  const auto refuse = [&](const std::string& why) {
+    throw InputError("reference cache folder '" + cache_dir + "' " + why + " (--cache-dir, $PDFLAB_REFERENCE_CACHE)");
+  };
+  // The folder itself, or the nearest part of its path that exists.
+  fs::path at = fs::path(cache_dir).lexically_normal();
+  for (;;) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(at, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory)
+      refuse("cannot be used: '" + at.string() + "': " + ec.message());  // a symlink loop, a file on the way
+    if (fs::exists(st)) {
+      if (!fs::is_directory(st))
+        refuse(at == fs::path(cache_dir).lexically_normal() ? "is a file, not a folder"
+                                                           : "cannot be made: '" + at.string() + "' is a file");
+      if (::access(at.c_str(), W_OK) != 0)
+        refuse("is not writable ('" + at.string() + "' does not let this user write)");
+      return;
+    }
+    if (!at.has_relative_path() || at.parent_path() == at) return;  // nothing of it exists: made relative to '.'
+    at = at.parent_path();
+    if (at.empty()) at = ".";
+  }
+}
+
 int run_reference(const ReferenceOptions& o) {
   if ((o.spp > 0) + (o.seconds > 0.0) + (o.target_relmse > 0.0) != 1)
     throw InputError("give exactly one of --spp, --seconds and --target-relmse");
@@ -56,6 +96,7 @@ int run_reference(const ReferenceOptions& o) {
   const Strategy strategy = with_roulette(
       o.strategy.empty() ? default_reference_strategy(*scene) : Strategy::parse(o.strategy), o.roulette_depth);
   const std::string cache_dir = reference_cache_dir(o.cache_dir);
+  check_cache_dir(cache_dir);  // before the render, not after it
   const ReferenceKey key = reference_key(*scene);
   const CacheLookup before = find_cached_reference(cache_dir, key);
   if (before.status == CacheLookup::Damaged && !o.quiet)
@@ -80,22 +121,23 @@ int run_reference(const ReferenceOptions& o) {
   }
   if (show_progress) std::fputc('\n', stderr);
   const Reference ref = build.finish();
-  const std::string cached = store_cached_reference(cache_dir, key, ref);
+  // --out first: should the cache fail after all (a full disk), the render is kept there.
   if (!o.out.empty()) save_reference(o.out, ref);
+  const std::string cached = store_cached_reference(cache_dir, key, ref);
   std::printf("reference: %s, %dx%d, depth %d, %s, seed stream %u, %u spp, %.2f s, est. relMSE %.4g -> %s%s%s\n",
-              scene->name.c_str(), ref.width, ref.height, scene->max_depth, ref.info.strategy.c_str(),
-              ref.info.seed_stream, ref.info.spp, ref.info.seconds, ref.info.estimated_relmse, cached.c_str(),
-              o.out.empty() ? "" : " and ", o.out.c_str());
+              printable(scene->name).c_str(), ref.width, ref.height, scene->max_depth, ref.info.strategy.c_str(),
+              ref.info.seed_stream, ref.info.spp, ref.info.seconds, ref.info.estimated_relmse, printable(cached).c_str(),
+              o.out.empty() ? "" : " and ", printable(o.out).c_str());
   return 0;
 }
 
 Reference resolve_reference(const std::string& option, const Scene& scene, const std::string& scene_file,
-                            const std::string& cache_dir, bool required, bool quiet) {
+                            const std::string& cache_dir, bool required, bool quiet, std::string* missing) {
   if (option.empty()) return {};
   if (option != "auto") return load_reference(option);
   const CacheLookup found = find_cached_reference(reference_cache_dir(cache_dir), reference_key(scene));
   if (found.status == CacheLookup::Found) {
-    if (!quiet) std::fprintf(stderr, "note: using the cached reference %s\n", found.path.c_str());
+    if (!quiet) std::fprintf(stderr, "note: using the cached reference %s\n", printable(found.path).c_str());
     return found.reference;
   }
   std::string why = found.status == CacheLookup::Damaged
@@ -105,7 +147,8 @@ Reference resolve_reference(const std::string& option, const Scene& scene, const
                               " in '" + reference_cache_dir(cache_dir) + "'";
   why += "; make one with: " + make_command(scene, scene_file);
   if (required) throw InputError(why);
-  if (!quiet) std::fprintf(stderr, "note: %s\n", why.c_str());
+  if (missing) *missing = why;
+  std::fprintf(stderr, "warning: --reference auto: %s; going on without a reference\n", printable(why).c_str());
   return {};
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace pdflab {
 
@@ -27,9 +28,21 @@ int run_reference(const ReferenceOptions& options);
 
 // `--reference FILE` or `--reference auto` of render and bench, for `scene` at
 // the size and depth it will render. auto looks in the cache: a miss or a
-// damaged entry is an InputError when `required`, otherwise a note on stderr
-// (unless quiet) and an empty Reference. A file is loaded as given.
+// damaged entry is an InputError when `required`, otherwise a warning on
+// stderr (with --quiet too: a measurement asked for will not be made), the
+// reason in `missing` when given, and an empty Reference. A file is loaded
+// as given.
 Reference resolve_reference(const std::string& option, const Scene& scene, const std::string& scene_file,
-                            const std::string& cache_dir, bool required, bool quiet);
+                            const std::string& cache_dir, bool required, bool quiet, std::string* missing = nullptr);
+
+// A note on stderr when `reference` does not record its seeds (a PFM without
+// a sidecar, from another program or copied alone): the seed trap cannot
+// check it against `seeds`, the runs' own.
+void note_unknown_seed(const Reference& reference, const std::vector<std::uint64_t>& seeds);
+
+// `--cache-dir` (or the default cache folder) where a reference will be
+// stored: a folder, or one that can be made (no file, symlink loop or file
+// on its way), writable. Checked before any rendering; InputError otherwise.
+void check_cache_dir(const std::string& cache_dir);
 
 }  // namespace pdflab

@@ -5,6 +5,7 @@
 #include "renderer/film/film.h"
 #include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/input_file.h"
 #include "renderer/integrator/packet.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/scene/scene_loader.h"
@@ -14,6 +15,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -80,9 +82,83 @@ void write_text(const std::string& path, const std::string& text) {
   write_file_atomic(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
 }
 
+std::string hex_hash(std::uint64_t hash) {
+  char text[24];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
 // What an EXR's header says about the estimate in it.
 std::vector<std::pair<std::string, std::string>> image_attributes(const FilmInfo& info) {
   return film_image_attributes(info, PDFLAB_VERSION);
+}
+
+// The same for a PFM, which has no room for it, in its sidecar (NAME.json
+// beside NAME.pfm, where load_reference looks): a PFM kept as a reference
+// still names its seeds.
+nlohmann::json identity_json(const FilmInfo& info) {
+  nlohmann::json j;
+  j["format"] = "pdflab-render";
+  j["scene_file"] = info.scene_file;
+  j["scene_hash"] = hex_hash(info.scene_hash);
+  j["strategy"] = info.strategy;
+  j["width"] = info.width;
+  j["height"] = info.height;
+  j["max_depth"] = info.max_depth;
+  const std::vector<std::uint64_t> seeds = info.seeds();
+  if (!seeds.empty()) j["seed"] = seeds.front();
+  j["seeds"] = seeds;
+  j["sample_ranges"] = info.ranges_text();
+  j["spp"] = info.spp();
+  j["seconds"] = info.seconds;
+  j["version"] = PDFLAB_VERSION;
+  return j;
+}
+
+// The sidecar a PFM output gets (empty for other formats).
+std::string sidecar_of(const std::string& image) {
+  if (image.empty() || image_format_for(image) != ImageFormat::Pfm) return {};
+  return reference_paths(image).sidecar;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  if (a.empty() || b.empty()) return false;
+  std::error_code ec;
+  if (std::filesystem::equivalent(a, b, ec)) return true;
+  return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
+         std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
+}
+
+// A sidecar may replace an earlier one (pdflab's: it names a strategy), never
+// another file that happens to share the image's name: the scene itself
+// (cornell.json beside cornell.pfm) or anything else.
+void check_sidecar(const std::string& sidecar, const std::string& image, const std::string& scene) {
+  if (sidecar.empty()) return;
+  check_output_path(sidecar);
+  if (same_file(sidecar, scene))
+    throw InputError("output '" + image + "': its sidecar '" + sidecar +
+                     "' (what identifies the image) would replace the scene file; choose another name");
+  std::error_code ec;
+  if (!std::filesystem::exists(sidecar, ec)) return;
+  bool ours = false;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_input_file(sidecar, "sidecar", 1 << 20));
+    ours = j.is_object() && j.contains("strategy");
+  } catch (const std::exception&) {
+    ours = false;
+  }
+  if (!ours)
+    throw InputError("output '" + image + "': its sidecar '" + sidecar +
+                     "' would replace a file that is not a pdflab sidecar; choose another name");
+}
+
+// The image with what identifies it: attributes in an EXR, a sidecar beside a
+// PFM (unless the stats JSON is that very file, which then carries it).
+void write_identified_image(const std::string& path, const Film& film, Transfer transfer, const FilmInfo& info,
+                            const std::string& stats_json) {
+  write_film_image(path, film, transfer, image_attributes(info));
+  if (const std::string sidecar = sidecar_of(path); !sidecar.empty() && !same_file(sidecar, stats_json))
+    write_text(sidecar, identity_json(info).dump(2) + "\n");
 }
 
 nlohmann::json drops_json(const DropCounts& dropped) {
@@ -127,16 +203,17 @@ Resumed open_resume(const RenderOptions& o) {
   if (o.first_sample_given && o.first_sample != range.first)
     throw InputError("--resume: " + film + " starts at sample " + std::to_string(range.first) + ", not " +
                      std::to_string(o.first_sample));
+  if (info.spp() > o.spp)
+    throw InputError("--resume: " + film + " holds " + std::to_string(info.spp()) + " samples per pixel, more than --spp " +
+                     std::to_string(o.spp) + " asks for in all");
   if ((o.width != 0 && o.width != info.width) || (o.height != 0 && o.height != info.height))
     throw InputError("--resume: " + film + " is " + std::to_string(info.width) + "x" + std::to_string(info.height) +
                      ", not the size asked for");
   return r;
 }
 
-}  // namespace
-
-int run_render(const RenderOptions& o) {
-  // Everything the user typed is checked before any work starts.
+// Everything the user typed is checked before any file is read.
+void check_render_options(const RenderOptions& o) {
   if (o.resume.empty() && !o.scene_given) throw InputError("--scene is required (unless --resume names a film)");
   if (o.resume.empty() && !o.strategy_given) throw InputError("--strategy is required (unless --resume names a film)");
   if (!o.spp_given) throw InputError("--spp is required");
@@ -150,230 +227,354 @@ int run_render(const RenderOptions& o) {
   const std::string film_out = o.film_out.empty() ? o.resume : o.film_out;
   if (!film_out.empty()) check_output_path(film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
-  check_distinct_outputs({o.out, film_out, o.stats_json});
-  const Transfer transfer = parse_transfer(o.transfer);
+  const std::string sidecar = o.out_given ? sidecar_of(o.out) : std::string();
+  check_distinct_outputs({o.out, film_out, o.stats_json, same_file(sidecar, o.stats_json) ? "" : sidecar});
+  (void)parse_transfer(o.transfer);
   if (o.threads < 0 || o.threads > 1024) throw InputError("--threads must be in 0..1024 (0: all cores)");
   if (!(o.checkpoint_seconds >= 0.0) || !std::isfinite(o.checkpoint_seconds))
     throw InputError("--checkpoint-seconds must be a number >= 0");
+}
 
+// What is rendered: the scene at its size, the strategy, the samples (seed and
+// first index) and the film it continues, if any; and where the film goes.
+struct RenderPlan {
   std::optional<Resumed> resumed;
-  if (!o.resume.empty()) resumed = open_resume(o);
-  const std::string scene_path = resumed ? resumed->scene : o.scene;
+  std::string scene_path;
+  std::shared_ptr<Scene> scene;
+  Strategy strategy;
+  FilmInfo info;  // the film's description, without its ranges, drops and time
+  std::uint64_t seed = 0;
+  std::uint32_t first_sample = 0;
+  std::string film_out;  // empty: no film is written
+  Transfer transfer = Transfer::Gamma2;
+  std::string reference_missing;  // --reference auto found nothing: why
+};
+
+RenderPlan plan_render(const RenderOptions& o) {
+  RenderPlan plan;
+  plan.transfer = parse_transfer(o.transfer);
+  plan.film_out = o.film_out.empty() ? o.resume : o.film_out;
+  if (!o.resume.empty()) plan.resumed = open_resume(o);
+  const std::optional<Resumed>& resumed = plan.resumed;
+  plan.scene_path = resumed ? resumed->scene : o.scene;
   const std::string strategy_text = resumed ? resumed->strategy : o.strategy;
 
-  auto scene = std::make_shared<Scene>(load_scene_file(scene_path));
+  plan.scene = std::make_shared<Scene>(load_scene_file(plan.scene_path));
+  Scene& scene = *plan.scene;
   const int width = resumed ? resumed->file.info.width : o.width;
   const int height = resumed ? resumed->file.info.height : o.height;
-  if (width != 0) scene->camera.width = width;
-  if (height != 0) scene->camera.height = height;
-  if (width != 0 || height != 0) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
-  scene->prepare();
-  const Strategy strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
-  (void)SamplingPlan::make(strategy, *scene);  // strategy/scene mismatch is bad input too
+  if (width != 0) scene.camera.width = width;
+  if (height != 0) scene.camera.height = height;
+  if (width != 0 || height != 0) check_image_size(scene.camera.width, scene.camera.height, "--width/--height");
+  scene.prepare();
+  plan.strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
+  (void)SamplingPlan::make(plan.strategy, scene);  // strategy/scene mismatch is bad input too
 
-  FilmInfo info;
-  info.scene_hash = film_scene_hash(*scene);
-  info.scene_file = scene_path;
-  info.width = scene->camera.width;
-  info.height = scene->camera.height;
-  info.max_depth = scene->max_depth;
-  info.strategy = strategy.to_string();
-  const std::uint64_t seed = resumed ? resumed->file.info.ranges.front().seed : o.seed;
-  const std::uint32_t first_sample = resumed ? resumed->file.info.ranges.front().first : o.first_sample;
-  if (std::uint64_t{first_sample} + o.spp > std::numeric_limits<std::uint32_t>::max())
-    throw InputError("--first-sample " + std::to_string(first_sample) + " plus --spp " + std::to_string(o.spp) +
+  FilmInfo& info = plan.info;
+  info.scene_hash = film_scene_hash(scene);
+  info.scene_file = plan.scene_path;
+  info.width = scene.camera.width;
+  info.height = scene.camera.height;
+  info.max_depth = scene.max_depth;
+  info.strategy = plan.strategy.to_string();
+  plan.seed = resumed ? resumed->file.info.ranges.front().seed : o.seed;
+  plan.first_sample = resumed ? resumed->file.info.ranges.front().first : o.first_sample;
+  if (std::uint64_t{plan.first_sample} + o.spp > std::numeric_limits<std::uint32_t>::max())
+    throw InputError("--first-sample " + std::to_string(plan.first_sample) + " plus --spp " + std::to_string(o.spp) +
                      " passes the last sample index (" + std::to_string(std::numeric_limits<std::uint32_t>::max()) + ")");
   if (resumed) {
     const FilmInfo& had = resumed->file.info;
     if (had.scene_hash != info.scene_hash || had.max_depth != info.max_depth)
-      throw InputError("--resume: film '" + o.resume + "' was rendered from another scene than '" + scene_path +
+      throw InputError("--resume: film '" + o.resume + "' was rendered from another scene than '" + plan.scene_path +
                        "' (its content or maximum depth differs)");
   }
+  return plan;
+}
 
-  // The reference is checked before any rendering: its size, and that the
-  // render would not repeat its random numbers.
-  const Reference reference = resolve_reference(o.reference, *scene, scene_path, o.cache_dir, false, o.quiet);
-  if (reference.loaded()) {
-    if (reference.width != scene->camera.width || reference.height != scene->camera.height)
-      throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
-                       std::to_string(reference.height) + " but the render is " +
-                       std::to_string(scene->camera.width) + "x" + std::to_string(scene->camera.height) +
-                       " (use --width/--height)");
-    if (const std::string shared = shared_random_numbers(reference.info, seed, strategy); !shared.empty())
-      throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
-  }
+// The reference is checked before any rendering: its size, and that the
+// render would not repeat its random numbers.
+Reference checked_reference(const RenderOptions& o, RenderPlan& plan) {
+  const Scene& scene = *plan.scene;
+  const Reference reference =
+      resolve_reference(o.reference, scene, plan.scene_path, o.cache_dir, false, o.quiet, &plan.reference_missing);
+  if (!reference.loaded()) return reference;
+  if (reference.width != scene.camera.width || reference.height != scene.camera.height)
+    throw InputError("reference '" + reference.path + "' is " + std::to_string(reference.width) + "x" +
+                     std::to_string(reference.height) + " but the render is " + std::to_string(scene.camera.width) +
+                     "x" + std::to_string(scene.camera.height) + " (use --width/--height)");
+  if (const std::string shared = shared_random_numbers(reference.info, plan.seed, plan.strategy); !shared.empty())
+    throw InputError("reference '" + reference.path + "': " + shared + "; choose another --seed");
+  if (!o.quiet) note_unknown_seed(reference, {plan.seed});
+  return reference;
+}
 
-  if (!strategy.is_unbiased() && !o.quiet)
+void note_bias(const Strategy& strategy, bool quiet) {
+  if (!strategy.is_unbiased() && !quiet)
     std::fprintf(stderr,
                  "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
                  "targets, so it omits indirect light\n",
                  strategy.to_string().c_str());
+}
 
-  SessionOptions session_options;
-  session_options.threads = o.threads;
-  session_options.publish_images = false;  // the film is read once, at the end
-  RenderSession session(session_options);
-  RenderSettings settings;
-  settings.scene = scene;
-  settings.strategy = strategy;
-  settings.seed = seed;
-  settings.target_spp = o.spp;
-  settings.first_sample = first_sample;
-  double seconds_before = 0.0;
-  if (resumed) {
-    FilmFile& file = resumed->file;
-    seconds_before = file.info.seconds;
-    const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
-    const DropCounts had_drops = file.info.dropped;
-    session.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
-  } else {
-    session.set_settings(settings);
+// The film's own estimate is noted at fixed sample counts, the powers of two
+// on the way and the end, where the session stops for a moment (one short
+// pass at most for each): the same samples give the same history, and so the
+// same verdict on the estimate, however the passes fell in time. (Noted
+// whenever a poll came by, the verdict of four identical renders differed.)
+std::uint32_t next_estimate_spp(std::uint32_t spp, std::uint32_t target) {
+  std::uint64_t n = 2;
+  while (n <= spp && n < target) n *= 2;
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(n, target));
+}
+
+// A render session on the plan's film, saving it as a film file on request
+// (checkpoints, an interruption, the end).
+class FilmRender {
+ public:
+  // A resumed film is moved out of the plan into the session.
+  FilmRender(const RenderOptions& o, RenderPlan& plan) : plan_(plan), session_(session_options(o)) {
+    RenderSettings settings;
+    settings.scene = plan.scene;
+    settings.strategy = plan.strategy;
+    settings.seed = plan.seed;
+    settings.first_sample = plan.first_sample;
+    const std::uint32_t had = plan.resumed ? static_cast<std::uint32_t>(plan.resumed->file.info.spp()) : 0;
+    settings.target_spp = next_estimate_spp(had, o.spp);
+    if (plan.resumed) {
+      FilmFile& file = plan.resumed->file;
+      seconds_before_ = file.info.seconds;
+      const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
+      const DropCounts had_drops = file.info.dropped;
+      session_.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
+    } else {
+      session_.set_settings(settings);
+    }
   }
 
+  RenderSession& session() { return session_; }
+
   // The film as it stands between two passes, with what it holds.
-  const auto save_film = [&](const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) {
-    FilmInfo now = info;
-    now.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
+  FilmInfo info_now(std::uint32_t spp, const DropCounts& dropped, double seconds) const {
+    FilmInfo now = plan_.info;
+    now.ranges = {SampleRange{plan_.seed, plan_.first_sample, plan_.first_sample + spp}};
     now.dropped = dropped;
-    now.seconds = seconds_before + seconds;
-    write_film_file(film_out, now, film);
+    now.seconds = seconds_before_ + seconds;
     return now;
-  };
-  const auto checkpoint = [&] {
-    session.set_paused(true);
-    const double seconds = session.stats().seconds;
+  }
+  FilmInfo save_film(const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) const {
+    const FilmInfo now = info_now(spp, dropped, seconds);
+    write_film_file(plan_.film_out, now, film);
+    return now;
+  }
+  // Pauses and saves the film; returns the spp saved (0: nothing yet).
+  std::uint32_t checkpoint() {
+    session_.set_paused(true);
+    const double seconds = session_.stats().seconds;
     std::uint32_t saved = 0;
-    session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+    session_.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
       if (spp > 0) save_film(film, spp, dropped, seconds);
       saved = spp;
     });
     return saved;
-  };
+  }
 
+ private:
+  static SessionOptions session_options(const RenderOptions& o) {
+    SessionOptions options;
+    options.threads = o.threads;
+    options.publish_images = false;  // the film is read once, at the end
+    return options;
+  }
+  const RenderPlan& plan_;
+  RenderSession session_;
+  double seconds_before_ = 0.0;
+};
+
+// Waits for the session, drawing progress, saving checkpoints and stopping on
+// SIGINT or SIGTERM. Returns kInterrupted when stopped, 0 when done; the
+// history receives the film's own estimates along the way.
+int wait_for_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& render, EstimateHistory& history) {
+  RenderSession& session = render.session();
   const StopSignals signals;
   const bool show_progress = !o.quiet && ::isatty(STDERR_FILENO);
   using Clock = std::chrono::steady_clock;
   auto last_checkpoint = Clock::now();
-  const bool checkpoints = !film_out.empty() && o.checkpoint_seconds > 0.0;
-  EstimateHistory history;  // is the film's own estimate trustworthy?
-  std::uint32_t history_spp = 0;
-  const auto note_estimate = [&](const SessionStats& now) {
-    if (now.spp > history_spp && now.estimated_relmse > 0.0) history.add(now.spp, now.estimated_relmse);
-    history_spp = std::max(history_spp, now.spp);
+  const bool checkpoints = !plan.film_out.empty() && o.checkpoint_seconds > 0.0;
+  std::uint32_t target = session.settings().target_spp;
+  // The progress of the whole render, not of the stretch to the next estimate.
+  const auto progress = [&] {
+    SessionStats st = session.stats();
+    st.progress = std::min(1.0, st.progress * target / o.spp);
+    return st;
   };
-  while (!session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
-    note_estimate(session.stats());
+  for (;;) {
+    if (session.wait_until_done(std::chrono::milliseconds(show_progress ? 200 : 100))) {
+      std::uint32_t spp = 0;
+      double estimate = 0.0;
+      session.read_film([&](const Film& film, std::uint32_t now, const DropCounts&) {
+        spp = now;
+        estimate = estimated_relmse(film);
+      });
+      history.add(spp, estimate);
+      if (spp >= o.spp) break;
+      target = next_estimate_spp(spp, o.spp);
+      session.set_target_spp(target);
+      continue;
+    }
     if (signals.stopped()) {
       if (show_progress) std::fputc('\n', stderr);
-      if (film_out.empty()) {
+      if (plan.film_out.empty()) {
         std::fprintf(stderr, "pdflab: interrupted; nothing written\n");
         return kInterrupted;
       }
-      const std::uint32_t saved = checkpoint();
+      const std::uint32_t saved = render.checkpoint();
       std::fprintf(stderr, "pdflab: interrupted at %u of %u spp; the film '%s' holds them: continue with "
-                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, film_out.c_str(), film_out.c_str(), o.spp);
+                   "'pdflab render --resume %s --spp %u'\n", saved, o.spp, printable(plan.film_out).c_str(),
+                   printable(plan.film_out).c_str(), o.spp);
       return kInterrupted;
     }
     if (checkpoints &&
         std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= o.checkpoint_seconds) {
-      checkpoint();
+      render.checkpoint();
       session.set_paused(false);
       last_checkpoint = Clock::now();
     }
-    if (show_progress) draw_progress(session.stats(), o.spp);
+    if (show_progress) draw_progress(progress(), o.spp);
   }
-  const SessionStats st = session.stats();
   if (show_progress) {
-    draw_progress(st, o.spp);
+    draw_progress(progress(), o.spp);
     std::fputc('\n', stderr);
-  }
-
-  FilmInfo final_info = info;
-  double estimate = 0.0;
-  RelMseMeasure error;
-  session.read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
-    if (!film_out.empty()) {
-      final_info = save_film(film, spp, dropped, st.seconds);
-    } else {
-      final_info.ranges = {SampleRange{seed, first_sample, first_sample + spp}};
-      final_info.dropped = dropped;
-      final_info.seconds = seconds_before + st.seconds;
-    }
-    if (o.out_given) write_film_image(o.out, film, transfer, image_attributes(final_info));
-    estimate = estimated_relmse(film);
-    if (reference.loaded()) error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
-  });
-  history.add(static_cast<std::uint32_t>(final_info.spp()), estimate);
-  const double measured_efficiency = efficiency(error.corrected, st.seconds);
-
-  if (!o.stats_json.empty()) {
-    nlohmann::json j;
-    j["scene"] = scene->name;
-    j["scene_file"] = scene_path;
-    j["strategy"] = strategy.to_string();
-    j["unbiased"] = strategy.is_unbiased();
-    j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
-    j["sampler"] = strategy.sobol ? "sobol" : "independent";  // +sobol
-    if (strategy.fastest) j["expanded_from"] = "fastest";
-    j["width"] = final_info.width;
-    j["height"] = final_info.height;
-    j["spp"] = final_info.spp();
-    j["seed"] = seed;
-    j["first_sample"] = first_sample;
-    j["threads"] = session.thread_count();
-    // What the speed figures came from (the images are the same bits with any).
-    j["tracer"] = std::string(packet_isa_name(best_packet_isa()));
-    j["tracer_lanes"] = packet_lanes(best_packet_isa());
-    j["seconds"] = st.seconds;
-    j["samples"] = st.samples;
-    j["samples_per_second"] = st.samples_per_second;
-    j["dropped"] = drops_json(final_info.dropped);
-    j["output"] = o.out;
-    if (!film_out.empty()) j["film"] = film_out;
-    // The film's own estimate is a lower bound: it cannot see what the samples never found.
-    j["est_relmse"] = estimate;
-    j["est_relmse_unreliable"] = history.unreliable();
-    if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(estimate, st.seconds);
-    if (reference.loaded()) {
-      j["reference"] = reference.path;
-      j["relmse"] = error.corrected;
-      j["relmse_interval"] = error.interval;
-      j["relmse_raw"] = error.raw;
-      j["reference_corrected"] = error.reference_corrected;
-      j["reference_share"] = error.reference_share();
-      j["efficiency"] = measured_efficiency;
-    }
-    write_text(o.stats_json, j.dump(2) + "\n");
-  }
-
-  const std::string target = o.out_given ? o.out : film_out;
-  std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
-              static_cast<unsigned long long>(final_info.spp()), final_info.width, final_info.height, st.seconds,
-              st.samples_per_second * 1e-6, session.thread_count(), drops_text(final_info.dropped).c_str(),
-              target.c_str());
-  if (reference.loaded()) {
-    std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
-                "efficiency %.4g\n",
-                error.corrected, error.interval, reference.path.c_str(), error.raw, 100.0 * error.reference_share(),
-                error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
-                measured_efficiency);
-  } else {
-    std::printf("est. relMSE %.4g: a lower bound from the film's own variance, blind to what its samples never "
-                "found; ",
-                estimate);
-    if (strategy.is_unbiased())
-      std::printf("efficiency estimate %.4g\n", efficiency(estimate, st.seconds));
-    else
-      std::printf("no efficiency: '%s' is biased and no reference shows how much light it misses\n",
-                  strategy.to_string().c_str());
-    if (history.unreliable())
-      std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
-                  "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
   }
   return 0;
 }
 
-int run_merge(const MergeOptions& o) {
+// What the finished render gives: the film's description as saved, its own
+// estimate and the error against the reference.
+struct RenderResult {
+  SessionStats stats;
+  FilmInfo info;
+  double estimate = 0.0;
+  RelMseMeasure error;
+  int threads = 0;
+};
+
+RenderResult finish_render(const RenderOptions& o, const RenderPlan& plan, FilmRender& render,
+                           const Reference& reference) {
+  RenderResult r;
+  r.stats = render.session().stats();
+  r.threads = render.session().thread_count();
+  r.info = plan.info;
+  render.session().read_film([&](const Film& film, std::uint32_t spp, const DropCounts& dropped) {
+    r.info = plan.film_out.empty() ? render.info_now(spp, dropped, r.stats.seconds)
+                                   : render.save_film(film, spp, dropped, r.stats.seconds);
+    if (o.out_given) write_identified_image(o.out, film, plan.transfer, r.info, o.stats_json);
+    r.estimate = estimated_relmse(film);
+    if (reference.loaded()) r.error = measure_relmse(film.mean_rgb(), reference.rgb, reference.variance);
+  });
+  return r;
+}
+
+void write_render_stats(const RenderOptions& o, const RenderPlan& plan, const RenderResult& r,
+                        const Reference& reference, const EstimateHistory& history) {
+  const bool unreliable = history.unreliable();
+  const Strategy& strategy = plan.strategy;
+  const SessionStats& st = r.stats;
+  nlohmann::json j = identity_json(r.info);  // so that it can be an image's sidecar too
+  j["scene"] = plan.scene->name;
+  j["scene_file"] = plan.scene_path;
+  j["strategy"] = strategy.to_string();
+  j["unbiased"] = strategy.is_unbiased();
+  j["russian_roulette_depth"] = strategy.roulette_depth;  // 0: off
+  j["sampler"] = strategy.sobol ? "sobol" : "independent";  // +sobol
+  if (strategy.fastest) j["expanded_from"] = "fastest";
+  j["width"] = r.info.width;
+  j["height"] = r.info.height;
+  j["spp"] = r.info.spp();
+  j["seed"] = plan.seed;
+  j["first_sample"] = plan.first_sample;
+  j["threads"] = r.threads;
+  // What the speed figures came from (the images are the same bits with any).
+  j["tracer"] = std::string(packet_isa_name(best_packet_isa()));
+  j["tracer_lanes"] = packet_lanes(best_packet_isa());
+  j["seconds"] = st.seconds;
+  j["samples"] = st.samples;
+  j["samples_per_second"] = st.samples_per_second;
+  j["dropped"] = drops_json(r.info.dropped);
+  j["output"] = o.out;
+  if (!plan.film_out.empty()) j["film"] = plan.film_out;
+  // The film's own estimate is a lower bound: it cannot see what the samples never found.
+  j["est_relmse"] = r.estimate;
+  j["est_relmse_unreliable"] = unreliable;
+  // The estimate at each power of two and at the end, which the verdict is
+  // drawn from: the same for the same samples, whatever the timing.
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& [spp, relmse_spp] : history.points()) points.push_back({spp, relmse_spp / spp});
+  j["est_relmse_history"] = points;
+  if (strategy.is_unbiased()) j["est_efficiency"] = efficiency(r.estimate, st.seconds);
+  if (!plan.reference_missing.empty()) j["reference_missing"] = plan.reference_missing;
+  if (reference.loaded()) {
+    j["reference"] = reference.path;
+    j["relmse"] = r.error.corrected;
+    j["relmse_interval"] = r.error.interval;
+    j["relmse_raw"] = r.error.raw;
+    j["reference_corrected"] = r.error.reference_corrected;
+    j["reference_share"] = r.error.reference_share();
+    j["efficiency"] = efficiency(r.error.corrected, st.seconds);
+  }
+  write_text(o.stats_json, j.dump(2) + "\n");
+}
+
+void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const RenderResult& r,
+                          const Reference& reference, bool unreliable) {
+  const SessionStats& st = r.stats;
+  const std::string target = o.out_given ? o.out : plan.film_out;
+  std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
+              static_cast<unsigned long long>(r.info.spp()), r.info.width, r.info.height, st.seconds,
+              st.samples_per_second * 1e-6, r.threads, drops_text(r.info.dropped).c_str(), printable(target).c_str());
+  if (reference.loaded()) {
+    std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
+                "efficiency %.4g\n",
+                r.error.corrected, r.error.interval, printable(reference.path).c_str(), r.error.raw,
+                100.0 * r.error.reference_share(),
+                r.error.reference_corrected ? "" : " (unknown: it has no variance, nothing subtracted)",
+                efficiency(r.error.corrected, st.seconds));
+    return;
+  }
+  std::printf("est. relMSE %.4g: a lower bound from the film's own variance, blind to what its samples never "
+              "found; ",
+              r.estimate);
+  if (plan.strategy.is_unbiased())
+    std::printf("efficiency estimate %.4g\n", efficiency(r.estimate, st.seconds));
+  else
+    std::printf("no efficiency: '%s' is biased and no reference shows how much light it misses\n",
+                plan.strategy.to_string().c_str());
+  if (unreliable)
+    std::printf("warning: the estimate is unreliable: relMSE * spp grew more than 2x over a doubling of samples "
+                "(rare bright paths are still being found); measure against a reference (--reference auto)\n");
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& o) {
+  check_render_options(o);
+  RenderPlan plan = plan_render(o);
+  if (o.out_given) check_sidecar(sidecar_of(o.out), o.out, plan.scene_path);
+  const Reference reference = checked_reference(o, plan);
+  note_bias(plan.strategy, o.quiet);
+
+  FilmRender render(o, plan);
+  EstimateHistory history;  // is the film's own estimate trustworthy?
+  if (const int status = wait_for_render(o, plan, render, history); status != 0) return status;
+  const RenderResult result = finish_render(o, plan, render, reference);
+
+  if (!o.stats_json.empty()) write_render_stats(o, plan, result, reference, history);
+  print_render_summary(o, plan, result, reference, history.unreliable());
+  return 0;
+}
+
+namespace {
+
+void check_merge_options(const MergeOptions& o) {
   if (o.films.empty()) throw InputError("merge: name at least one film");
   if (o.out.empty() && o.film_out.empty()) throw InputError("merge: nothing to write: give --out IMAGE, --film-out FILM or both");
   if (!o.out.empty()) {
@@ -382,49 +583,103 @@ int run_merge(const MergeOptions& o) {
   }
   if (!o.film_out.empty()) check_output_path(o.film_out);
   if (!o.stats_json.empty()) check_output_path(o.stats_json);
-  check_distinct_outputs({o.out, o.film_out, o.stats_json});
-  const Transfer transfer = parse_transfer(o.transfer);
-
+  const std::string sidecar = sidecar_of(o.out);
+  check_distinct_outputs({o.out, o.film_out, o.stats_json, same_file(sidecar, o.stats_json) ? "" : sidecar});
+  (void)parse_transfer(o.transfer);
   for (std::size_t i = 0; i < o.films.size(); ++i)
     for (std::size_t k = 0; k < i; ++k) {
       std::error_code ec;
       if (std::filesystem::equivalent(o.films[i], o.films[k], ec))
         throw InputError("merge: film '" + o.films[i] + "' is named twice; its samples would be counted twice");
     }
+}
 
-  // Each film is checked against every one before it, so a refusal names the
-  // two files that disagree; then it is added and dropped.
-  FilmFile all = read_film_file(o.films.front());
-  std::vector<FilmInfo> seen{all.info};
-  for (std::size_t i = 1; i < o.films.size(); ++i) {
-    FilmFile next = read_film_file(o.films[i]);
+// Each film is checked against every one before it, so a refusal names the
+// two files that disagree; then it is added and dropped. `each` receives
+// every film's own description, in the order given.
+FilmFile merge_films(const std::vector<std::string>& films, std::vector<FilmInfo>& each) {
+  FilmFile all = read_film_file(films.front());
+  each = {all.info};
+  for (std::size_t i = 1; i < films.size(); ++i) {
+    FilmFile next = read_film_file(films[i]);
     for (std::size_t k = 0; k < i; ++k)
-      if (const std::string problem = merge_problem(o.films[k], seen[k], o.films[i], next.info); !problem.empty())
+      if (const std::string problem = merge_problem(films[k], each[k], films[i], next.info); !problem.empty())
         throw InputError(problem);
     all.film.add_film(next.film);
     all.info = merged_info(all.info, next.info);
-    seen.push_back(std::move(next.info));
+    each.push_back(std::move(next.info));
   }
+  return all;
+}
+
+std::string range_text(std::uint64_t seed, std::uint64_t first, std::uint64_t end) {
+  return "seed " + std::to_string(seed) + " samples [" + std::to_string(first) + ", " + std::to_string(end) + ")";
+}
+
+// --expect-spp N: the merge must be the whole of [0, N) of one seed, as a
+// fan-out of one render is. A part that failed, or stopped early and saved
+// what it had, leaves a gap; the refusal names each missing range and the
+// film that ends where it starts (a part that stopped early).
+void check_expected_samples(const MergeOptions& o, const FilmInfo& all, const std::vector<FilmInfo>& each) {
+  const std::uint32_t n = o.expect_spp;
+  const std::vector<std::uint64_t> seeds = all.seeds();
+  if (seeds.size() != 1)
+    throw InputError("merge: the films hold samples of " + std::to_string(seeds.size()) + " seeds (" +
+                     all.ranges_text() + "); --expect-spp " + std::to_string(n) + " expects one seed's [0, " +
+                     std::to_string(n) + ")");
+  const std::uint64_t seed = seeds.front();
+  std::string missing, beyond;
+  std::uint64_t at = 0;
+  const auto name_missing = [&](std::uint64_t first, std::uint64_t end) {
+    std::string ender;
+    for (std::size_t i = 0; i < each.size() && ender.empty(); ++i)
+      for (const SampleRange& r : each[i].ranges)
+        if (r.end == first) ender = " after '" + o.films[i] + "', which ends there";
+    if (!missing.empty()) missing += "; ";
+    missing += range_text(seed, first, end);
+    missing += ender;
+  };
+  for (const SampleRange& r : all.ranges) {  // sorted, touching ones joined (merged_info)
+    if (r.first > at && at < n) name_missing(at, std::min<std::uint64_t>(r.first, n));
+    if (r.end > n) {
+      if (!beyond.empty()) beyond += ", ";
+      beyond += range_text(seed, std::max<std::uint64_t>(r.first, n), r.end);
+    }
+    at = std::max<std::uint64_t>(at, r.end);
+  }
+  if (at < n) name_missing(at, n);
+  if (missing.empty() && beyond.empty()) return;
+  std::string why = "merge: the films hold " + std::to_string(all.spp()) + " of the " + std::to_string(n) +
+                    " samples per pixel expected (" + all.ranges_text() + ")";
+  if (!missing.empty())
+    why += "; missing " + missing + ": render the missing samples (or resume the film that stopped) and merge again";
+  if (!beyond.empty()) why += "; beyond [0, " + std::to_string(n) + "): " + beyond;
+  throw InputError(why);
+}
+
+}  // namespace
+
+int run_merge(const MergeOptions& o) {
+  check_merge_options(o);
+  const Transfer transfer = parse_transfer(o.transfer);
+  std::vector<FilmInfo> each;
+  const FilmFile all = merge_films(o.films, each);
+  if (o.expect_spp > 0) check_expected_samples(o, all.info, each);
+  if (!o.out.empty()) check_sidecar(sidecar_of(o.out), o.out, all.info.scene_file);
 
   if (!o.film_out.empty()) write_film_file(o.film_out, all.info, all.film);
-  if (!o.out.empty()) write_film_image(o.out, all.film, transfer, image_attributes(all.info));
+  if (!o.out.empty()) write_identified_image(o.out, all.film, transfer, all.info, o.stats_json);
   if (!o.stats_json.empty()) {
-    nlohmann::json j;
+    nlohmann::json j = identity_json(all.info);
     j["films"] = o.films;
-    j["scene_file"] = all.info.scene_file;
-    j["strategy"] = all.info.strategy;
-    j["width"] = all.info.width;
-    j["height"] = all.info.height;
-    j["spp"] = all.info.spp();
     j["samples"] = all.info.ranges_text();
-    j["seconds"] = all.info.seconds;
     j["dropped"] = drops_json(all.info.dropped);
     write_text(o.stats_json, j.dump(2) + "\n");
   }
   std::printf("merged %zu films: %llu spp (%s), %dx%d, %.2f s of rendering, %s -> %s\n", o.films.size(),
               static_cast<unsigned long long>(all.info.spp()), all.info.ranges_text().c_str(), all.info.width,
               all.info.height, all.info.seconds, drops_text(all.info.dropped).c_str(),
-              (!o.out.empty() ? o.out : o.film_out).c_str());
+              printable(!o.out.empty() ? o.out : o.film_out).c_str());
   return 0;
 }
 

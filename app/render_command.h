@@ -40,6 +40,9 @@ struct MergeOptions {
   std::vector<std::string> films;
   std::string out, film_out, stats_json;
   std::string transfer = "gamma2";
+  // > 0: the films must hold exactly the samples [0, expect_spp) of one seed
+  // (a fan-out's whole); a gap or anything beyond is refused, named.
+  std::uint32_t expect_spp = 0;
 };
 
 // Runs `pdflab merge`: adds films of one scene and settings with disjoint

@@ -384,93 +384,113 @@ std::string num(double v) {
   return buf;
 }
 
-}  // namespace
-
-int run_sweep(const SweepOptions& o) {
-  if (o.seconds != 0.0 && !(std::isfinite(o.seconds) && o.seconds > 0.0))
-    throw InputError("--seconds must be a positive number of seconds");
-  if ((o.seconds > 0) == (o.spp > 0)) throw InputError("give exactly one of --seconds (equal time) and --spp (equal samples)");
-  if (o.seeds < 1 || o.seeds > 1000) throw InputError("--seeds must be in 1..1000");
-  if (o.threads < 0) throw InputError("--threads must be >= 0");
-  check_output_path(o.csv);
-  if (!o.plot.empty()) check_output_path(o.plot);
-  if (!o.map.empty()) check_output_path(o.map);
-  check_distinct_outputs({o.csv, o.plot, o.map});
-  const std::vector<double> weights = parse_weights(o.weights);
-  const TechniquePair family = parse_technique_pair(o.vary, o.strategy, o.roulette_depth);
-  auto scene = std::make_shared<Scene>(load_scene_file(o.scene));
-  // Every strategy of the sweep is checked against the scene before the first render.
+// What the runs need, all checked before the first: the weights and their
+// strategies (one row each), the scene (sized by the reference), the seeds,
+// the reference, and the prediction's pilot row and weight grid.
+struct SweepPlan {
+  std::vector<double> weights;
+  TechniquePair family;
+  MixtureFamily mixture_family;
+  std::shared_ptr<Scene> scene;
   std::vector<Row> rows;
-  for (double w : weights) {
-    Row r;
-    r.weight = w;
-    r.strategy = family.at(w);
-    (void)SamplingPlan::make(r.strategy, *scene);
-    r.unbiased = r.strategy.is_unbiased();
-    rows.push_back(r);
-  }
   std::vector<std::uint64_t> seeds;
-  for (int k = 0; k < o.seeds; ++k) seeds.push_back(o.seed + static_cast<std::uint64_t>(k));
-  std::vector<Strategy> strategies;
-  for (const Row& r : rows) strategies.push_back(r.strategy);
-  const Reference reference =
-      comparison_reference(*scene, {o.reference, o.scene, o.cache_dir, o.width, o.height}, strategies, seeds, o.quiet);
-
+  Reference reference;
   // The prediction replays the paths of the runs at one weight, the pilot: the
   // row nearest 0.5 that lies inside the defensive floor (see
   // weight_prediction.h). It predicts on the rows' weights and a fine grid.
   int pilot = -1;
+  std::vector<double> grid;
+  std::size_t grid_index(double w) const {
+    return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
+  }
+};
+
+SweepPlan plan_sweep(const SweepOptions& o) {
+  SweepPlan plan;
+  plan.weights = parse_weights(o.weights);
+  plan.family = parse_technique_pair(o.vary, o.strategy, o.roulette_depth);
+  plan.scene = std::make_shared<Scene>(load_scene_file(o.scene));
+  // Every strategy of the sweep is checked against the scene before the first render.
+  for (double w : plan.weights) {
+    Row r;
+    r.weight = w;
+    r.strategy = plan.family.at(w);
+    (void)SamplingPlan::make(r.strategy, *plan.scene);
+    r.unbiased = r.strategy.is_unbiased();
+    plan.rows.push_back(r);
+  }
+  for (int k = 0; k < o.seeds; ++k) plan.seeds.push_back(o.seed + static_cast<std::uint64_t>(k));
+  std::vector<Strategy> strategies;
+  for (const Row& r : plan.rows) strategies.push_back(r.strategy);
+  plan.reference = comparison_reference(*plan.scene, reference_choice(o), strategies, plan.seeds, o.quiet);
+
+  const std::vector<Row>& rows = plan.rows;
   for (std::size_t i = 0; i < rows.size(); ++i)
     if (defended_weight(rows[i].weight) == rows[i].weight &&
-        (pilot < 0 || std::fabs(rows[i].weight - 0.5) < std::fabs(rows[static_cast<std::size_t>(pilot)].weight - 0.5)))
-      pilot = static_cast<int>(i);
-  std::vector<double> grid = weight_grid(101);
-  grid.insert(grid.end(), weights.begin(), weights.end());
-  std::sort(grid.begin(), grid.end());
-  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-  const MixtureFamily mixture_family = family.mixture_family();
+        (plan.pilot < 0 ||
+         std::fabs(rows[i].weight - 0.5) < std::fabs(rows[static_cast<std::size_t>(plan.pilot)].weight - 0.5)))
+      plan.pilot = static_cast<int>(i);
+  plan.grid = weight_grid(101);
+  plan.grid.insert(plan.grid.end(), plan.weights.begin(), plan.weights.end());
+  std::sort(plan.grid.begin(), plan.grid.end());
+  plan.grid.erase(std::unique(plan.grid.begin(), plan.grid.end()), plan.grid.end());
+  plan.mixture_family = plan.family.mixture_family();
+  return plan;
+}
+
+// Every run's figures, per row (one value per seed), and auto weight's.
+struct SweepRuns {
+  std::vector<std::vector<double>> seconds, relmse, relmse_spp, samples_per_second, per_sample;
   std::vector<WeightPrediction> predictions;  // one per seed of the pilot
   std::vector<std::uint8_t> map_png;          // from the pilot's first seed
+  std::vector<double> auto_relmse_spp, auto_per_sample, auto_relmse, auto_seconds, auto_offset;
+  std::vector<std::vector<double>> auto_weights;
+};
 
+// The pilot's paths replayed for the prediction (and the map, from its first seed).
+void predict_from_pilot(const SweepPlan& plan, const SweepOptions& o, const Row& row, std::uint64_t seed,
+                        const Run& run, SweepRuns& runs) {
+  WeightPathOptions po;
+  po.seed = seed;
+  const Scene& scene = *plan.scene;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(scene.camera.width) * static_cast<std::uint64_t>(scene.camera.height);
+  po.samples = std::min({run.spp, kPredictionSpp,
+                         static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (kPredictionPaths + pixels - 1) / pixels))});
+  po.threads = o.threads;
+  const WeightPredictor predictor = record_weight_paths(scene, plan.mixture_family, row.strategy, row.weight, plan.grid, po);
+  if (!o.map.empty() && runs.map_png.empty())
+    runs.map_png = best_weight_png(predictor, plan.reference.rgb, scene.camera.width, scene.camera.height);
+  runs.predictions.push_back(predictor.predict(plan.reference.rgb, run.cost_seconds / run.spp, kRelMseEpsilon));
+}
+
+// Seed by seed, every weight (and auto weight) in turn: on a machine whose
+// speed drifts, each weight's runs are spread over the whole sweep, so the
+// drift falls on all weights alike instead of on a few.
+SweepRuns run_sweep_runs(SweepPlan& plan, const SweepOptions& o) {
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   const bool show_progress = !o.quiet && tty;
-  const double load_at_start = load_average();
-  // Seed by seed, every weight (and auto weight) in turn: on a machine whose
-  // speed drifts, each weight's runs are spread over the whole sweep, so the
-  // drift falls on all weights alike instead of on a few.
+  std::vector<Row>& rows = plan.rows;
   const std::size_t total = rows.size() * static_cast<std::size_t>(o.seeds);
   std::size_t done_runs = 0;
-  std::vector<std::vector<double>> seconds(rows.size()), rel(rows.size()), relspp(rows.size()), sps(rows.size()),
-      per_sample(rows.size());
-  std::vector<double> auto_relspp, auto_per_sample, auto_rel, auto_sec, auto_offset;
-  std::vector<std::vector<double>> auto_weights;
+  SweepRuns runs;
+  for (auto* v : {&runs.seconds, &runs.relmse, &runs.relmse_spp, &runs.samples_per_second, &runs.per_sample})
+    v->resize(rows.size());
   for (int k = 0; k < o.seeds; ++k) {
+    const std::uint64_t seed = plan.seeds[static_cast<std::size_t>(k)];
     for (std::size_t i = 0; i < rows.size(); ++i) {
       Row& r = rows[i];
       char label[96];
-      std::snprintf(label, sizeof label, "[%zu/%zu] %s=%.3g seed %d/%d", ++done_runs, total, family.a.c_str(), r.weight,
-                    k + 1, o.seeds);
-      const Run run = render_once(scene, r.strategy, seeds[static_cast<std::size_t>(k)], o, reference, label,
-                                  show_progress);
+      std::snprintf(label, sizeof label, "[%zu/%zu] %s=%.3g seed %d/%d", ++done_runs, total, plan.family.a.c_str(),
+                    r.weight, k + 1, o.seeds);
+      const Run run = render_once(plan.scene, r.strategy, seed, o, plan.reference, label, show_progress);
       if (k == 0) r.spp = run.spp;
-      if (static_cast<int>(i) == pilot && run.spp > 0) {
-        WeightPathOptions po;
-        po.seed = seeds[static_cast<std::size_t>(k)];
-        const std::uint64_t pixels = static_cast<std::uint64_t>(scene->camera.width) * static_cast<std::uint64_t>(scene->camera.height);
-        po.samples = std::min({run.spp, kPredictionSpp,
-                               static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (kPredictionPaths + pixels - 1) / pixels))});
-        po.threads = o.threads;
-        const WeightPredictor predictor = record_weight_paths(*scene, mixture_family, r.strategy, r.weight, grid, po);
-        if (!o.map.empty() && map_png.empty())
-          map_png = best_weight_png(predictor, reference.rgb, scene->camera.width, scene->camera.height);
-        predictions.push_back(predictor.predict(reference.rgb, run.cost_seconds / run.spp, kRelMseEpsilon));
-      }
-      seconds[i].push_back(run.seconds);
-      rel[i].push_back(run.relmse);
-      sps[i].push_back(run.samples_per_second);
+      if (static_cast<int>(i) == plan.pilot && run.spp > 0) predict_from_pilot(plan, o, r, seed, run, runs);
+      runs.seconds[i].push_back(run.seconds);
+      runs.relmse[i].push_back(run.relmse);
+      runs.samples_per_second[i].push_back(run.samples_per_second);
       if (run.spp > 0) {
-        relspp[i].push_back(run.relmse * run.spp);
-        per_sample[i].push_back(run.cost_seconds / run.spp);
+        runs.relmse_spp[i].push_back(run.relmse * run.spp);
+        runs.per_sample[i].push_back(run.cost_seconds / run.spp);
       }
       if (!o.quiet && !tty)
         std::fprintf(stderr, "%s: %u spp, %.2f s (priced %.2f s), relMSE %.4g, efficiency %.4g, load %.2f\n", label,
@@ -479,161 +499,227 @@ int run_sweep(const SweepOptions& o) {
     if (!o.auto_weight) continue;
     char label[64];
     std::snprintf(label, sizeof label, "[auto] seed %d/%d", k + 1, o.seeds);
-    const AutoRun a = render_auto(scene, family, mixture_family, seeds[static_cast<std::size_t>(k)], o, reference,
-                                  label, show_progress);
+    const AutoRun a = render_auto(plan.scene, plan.family, plan.mixture_family, seed, o, plan.reference, label,
+                                  show_progress);
     if (a.run.spp > 0) {
-      auto_relspp.push_back(a.run.relmse * a.run.spp);
-      auto_per_sample.push_back(a.run.cost_seconds / a.run.spp);
+      runs.auto_relmse_spp.push_back(a.run.relmse * a.run.spp);
+      runs.auto_per_sample.push_back(a.run.cost_seconds / a.run.spp);
     }
-    auto_rel.push_back(a.run.relmse);
-    auto_sec.push_back(a.run.seconds);
-    auto_weights.push_back(a.weights);
-    auto_offset.push_back(a.cost.offset());
+    runs.auto_relmse.push_back(a.run.relmse);
+    runs.auto_seconds.push_back(a.run.seconds);
+    runs.auto_weights.push_back(a.weights);
+    runs.auto_offset.push_back(a.cost.offset());
     if (!o.quiet && !tty)
       std::fprintf(stderr, "%s: %u spp, %.2f s (%.3f s predicting; priced %.2f s), relMSE %.4g, efficiency %.4g, load %.2f\n",
                    label, a.run.spp, a.run.seconds, a.replay_seconds, a.run.cost_seconds, a.run.relmse, a.run.efficiency,
                    load_average());
   }
+  if (show_progress) std::fputc('\n', stderr);
+  return runs;
+}
+
+void summarise_rows(std::vector<Row>& rows, const SweepRuns& runs) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    rows[i].seconds = interval(seconds[i]);
-    rows[i].relmse = interval(rel[i]);
-    rows[i].relmse_spp = interval(relspp[i]);
-    rows[i].efficiency = pooled_efficiency(relspp[i], per_sample[i]);
-    rows[i].samples_per_second = interval(sps[i]);
+    rows[i].seconds = interval(runs.seconds[i]);
+    rows[i].relmse = interval(runs.relmse[i]);
+    rows[i].relmse_spp = interval(runs.relmse_spp[i]);
+    rows[i].efficiency = pooled_efficiency(runs.relmse_spp[i], runs.per_sample[i]);
+    rows[i].samples_per_second = interval(runs.samples_per_second[i]);
   }
-  // The cost model (weight_prediction.h): every row's measured seconds per
-  // sample against the rays per sample that the pilot's paths predict at its
-  // weight. The rows' weights spread the rays, so their times tell the fixed
-  // cost per sample from the cost per ray. The prediction is then re-priced
-  // by it.
-  auto grid_index = [&](double w) {
-    return static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), w) - grid.begin());
-  };
-  std::vector<double> row_rays(rows.size(), std::nan("")), row_seconds_per_sample(rows.size(), std::nan(""));
-  // The pilot's seeds pooled once (pooled_prediction, each counted by its
-  // paths): the pool's rays at each weight go into the cost fit, and the pool
-  // priced by the fitted model is the predicted curve (below).
-  WeightPrediction pooled = pooled_prediction(predictions, kRaysAlone);
-  const std::vector<double>& pooled_rays = pooled.cost;
+}
+
+// The cost model (weight_prediction.h): every row's measured seconds per
+// sample against the rays per sample that the pilot's paths predict at its
+// weight. The rows' weights spread the rays, so their times tell the fixed
+// cost per sample from the cost per ray. The pilot's seeds are pooled once
+// (pooled_prediction, each counted by its paths): the pool's rays at each
+// weight go into the cost fit, and the pool priced by the fitted model is the
+// predicted curve (predict_rows).
+struct CostFitted {
+  std::vector<double> row_rays, row_seconds_per_sample;
+  WeightPrediction pooled;
+  CostModel model;
+};
+
+CostFitted fit_cost(const SweepPlan& plan, SweepRuns& runs) {
+  const std::vector<Row>& rows = plan.rows;
+  CostFitted c;
+  c.row_rays.assign(rows.size(), std::nan(""));
+  c.row_seconds_per_sample.assign(rows.size(), std::nan(""));
+  c.pooled = pooled_prediction(runs.predictions, kRaysAlone);
+  const std::vector<double>& pooled_rays = c.pooled.cost;
   CostFit cost_fit;
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    row_seconds_per_sample[i] = interval(per_sample[i]).mean;
-    if (pooled_rays.empty() || per_sample[i].empty()) continue;
-    row_rays[i] = pooled_rays[grid_index(rows[i].weight)];
-    cost_fit.add(row_rays[i], row_seconds_per_sample[i]);
+    c.row_seconds_per_sample[i] = interval(runs.per_sample[i]).mean;
+    if (pooled_rays.empty() || runs.per_sample[i].empty()) continue;
+    c.row_rays[i] = pooled_rays[plan.grid_index(rows[i].weight)];
+    cost_fit.add(c.row_rays[i], c.row_seconds_per_sample[i]);
   }
-  const CostModel cost_model = cost_fit.fit(AutoWeight::kPriorOffset);
-  if (cost_model.per_ray > 0.0)
-    for (WeightPrediction& p : predictions) apply_cost_model(p, cost_model);
+  c.model = cost_fit.fit(AutoWeight::kPriorOffset);
+  if (c.model.per_ray > 0.0)
+    for (WeightPrediction& p : runs.predictions) apply_cost_model(p, c.model);
+  return c;
+}
 
-  const Interval auto_relspp_interval = interval(auto_relspp);
-  const Interval auto_efficiency = pooled_efficiency(auto_relspp, auto_per_sample), auto_relmse = interval(auto_rel),
-                 auto_seconds = interval(auto_sec);
-  if (show_progress) std::fputc('\n', stderr);
+// The best weight among the unbiased ones (a biased mixture's error stops
+// falling with time, so its efficiency says nothing about longer runs), and
+// the weights whose efficiency cannot be told from the best's at 95 %: the
+// contiguous run around it whose upper bound reaches the best's lower bound.
+struct BestRow {
+  int best = -1, band_lo = -1, band_hi = -1;
+  double efficiency = 0.0;
+};
 
-  // The best weight among the unbiased ones (a biased mixture's error stops
-  // falling with time, so its efficiency says nothing about longer runs), and
-  // the weights whose efficiency cannot be told from the best's at 95 %: the
-  // contiguous run around it whose upper bound reaches the best's lower bound.
-  int best = -1;
+BestRow best_row(const std::vector<Row>& rows) {
+  BestRow b;
   for (std::size_t i = 0; i < rows.size(); ++i)
     if (rows[i].unbiased && std::isfinite(rows[i].efficiency.mean) &&
-        (best < 0 || rows[i].efficiency.mean > rows[static_cast<std::size_t>(best)].efficiency.mean))
-      best = static_cast<int>(i);
-  int band_lo = best, band_hi = best;
-  if (best >= 0) {
-    const double floor_value = rows[static_cast<std::size_t>(best)].efficiency.lo();
-    while (band_lo > 0 && rows[static_cast<std::size_t>(band_lo - 1)].unbiased &&
-           rows[static_cast<std::size_t>(band_lo - 1)].efficiency.hi() >= floor_value)
-      --band_lo;
-    while (band_hi + 1 < static_cast<int>(rows.size()) && rows[static_cast<std::size_t>(band_hi + 1)].unbiased &&
-           rows[static_cast<std::size_t>(band_hi + 1)].efficiency.hi() >= floor_value)
-      ++band_hi;
+        (b.best < 0 || rows[i].efficiency.mean > rows[static_cast<std::size_t>(b.best)].efficiency.mean))
+      b.best = static_cast<int>(i);
+  b.band_lo = b.band_hi = b.best;
+  if (b.best >= 0) {
+    const double floor_value = rows[static_cast<std::size_t>(b.best)].efficiency.lo();
+    while (b.band_lo > 0 && rows[static_cast<std::size_t>(b.band_lo - 1)].unbiased &&
+           rows[static_cast<std::size_t>(b.band_lo - 1)].efficiency.hi() >= floor_value)
+      --b.band_lo;
+    while (b.band_hi + 1 < static_cast<int>(rows.size()) && rows[static_cast<std::size_t>(b.band_hi + 1)].unbiased &&
+           rows[static_cast<std::size_t>(b.band_hi + 1)].efficiency.hi() >= floor_value)
+      ++b.band_hi;
   }
-  const double best_efficiency = best >= 0 ? rows[static_cast<std::size_t>(best)].efficiency.mean : 0.0;
-  const BestFixed fair = fair_best_fixed(rows, relspp, per_sample, best);
+  b.efficiency = b.best >= 0 ? rows[static_cast<std::size_t>(b.best)].efficiency.mean : 0.0;
+  return b;
+}
 
-  // The prediction on each row's weight and on the fine grid, pooled over the
-  // pilot's seeds (pooled_prediction) as the measured rows are, not the mean
-  // of each seed's efficiency; priced by the cost model, `rays_only` by the
-  // pilot's time per ray.
-  const double pilot_seconds = pilot >= 0 ? row_seconds_per_sample[static_cast<std::size_t>(pilot)] : std::nan("");
-  std::vector<double> predicted_best;
+// The predicted curve: pooled over the pilot's seeds (pooled_prediction) as
+// the measured rows are, not the mean of each seed's efficiency; priced by the
+// cost model, `rays_only` by the pilot's time per ray.
+struct PredictedCurve {
+  WeightPrediction pooled, rays_only;
+  std::vector<double> per_seed_best;  // each seed's own predicted best weight
+  int top = -1;                       // the pooled curve's best grid point, inside the defensive floor
+  double peak = 0.0;                  // its maximum over the sweep's range, the measured peak's counterpart
+  Interval optimum;                   // the best weight: the pooled curve's, +- the seeds' spread
+};
+
+PredictedCurve predict_rows(SweepPlan& plan, const SweepRuns& runs, CostFitted& cost) {
+  std::vector<Row>& rows = plan.rows;
+  const std::vector<double>& grid = plan.grid;
+  const std::vector<WeightPrediction>& predictions = runs.predictions;
+  PredictedCurve c;
+  const double pilot_seconds =
+      plan.pilot >= 0 ? cost.row_seconds_per_sample[static_cast<std::size_t>(plan.pilot)] : std::nan("");
   for (const WeightPrediction& p : predictions)
-    if (p.best >= 0) predicted_best.push_back(p.best_weight());
-  if (pooled.paths > 0) apply_cost_model(pooled, cost_model);  // as pooled_prediction prices a pool with paths
-  WeightPrediction rays_only = pooled;
-  if (!predictions.empty()) apply_cost_model(rays_only, CostModel{0.0, pilot_seconds / pooled.sampling_cost, false});
+    if (p.best >= 0) c.per_seed_best.push_back(p.best_weight());
+  WeightPrediction& pooled = cost.pooled;
+  if (pooled.paths > 0) apply_cost_model(pooled, cost.model);  // as pooled_prediction prices a pool with paths
+  c.rays_only = pooled;
+  if (!predictions.empty()) apply_cost_model(c.rays_only, CostModel{0.0, pilot_seconds / pooled.sampling_cost, false});
   const std::vector<double>& predicted_rays = pooled.cost;
   const std::vector<double>& predicted_curve = pooled.efficiency;
   auto inverse = [](double d) { return std::isfinite(d) && d > 0.0 ? 1.0 / d : 0.0; };
-  int predicted_top = -1;  // the pooled curve's best, inside the defensive floor
-  double predicted_peak = 0.0;  // its maximum over the sweep's range, the measured peak's counterpart
   for (std::size_t g = 0; g < grid.size() && !predictions.empty(); ++g) {
     if (defended_weight(grid[g]) == grid[g] &&
-        (predicted_top < 0 || predicted_curve[g] > predicted_curve[static_cast<std::size_t>(predicted_top)]))
-      predicted_top = static_cast<int>(g);
-    if (grid[g] >= weights.front() - 1e-9 && grid[g] <= weights.back() + 1e-9)
-      predicted_peak = std::max(predicted_peak, predicted_curve[g]);
+        (c.top < 0 || predicted_curve[g] > predicted_curve[static_cast<std::size_t>(c.top)]))
+      c.top = static_cast<int>(g);
+    if (grid[g] >= plan.weights.front() - 1e-9 && grid[g] <= plan.weights.back() + 1e-9)
+      c.peak = std::max(c.peak, predicted_curve[g]);
   }
-  if (predicted_top >= 0 && !(predicted_curve[static_cast<std::size_t>(predicted_top)] > 0.0)) predicted_top = -1;
+  if (c.top >= 0 && !(predicted_curve[static_cast<std::size_t>(c.top)] > 0.0)) c.top = -1;
   for (Row& r : rows) {
     if (predictions.empty()) {
       r.predicted.mean = r.predicted_rays_only = r.predicted_relmse_spp.mean = std::nan("");
       continue;
     }
-    const std::size_t g = grid_index(r.weight);
+    const std::size_t g = plan.grid_index(r.weight);
     std::vector<double> values;
     for (const WeightPrediction& p : predictions) values.push_back(p.relative_variance[g]);
     r.predicted_relmse_spp = interval(values);
-    const double seconds_here = cost_model.seconds(predicted_rays[g]);
+    const double seconds_here = cost.model.seconds(predicted_rays[g]);
     r.predicted.mean = predicted_curve[g];
     r.predicted.low = inverse(r.predicted_relmse_spp.hi() * seconds_here);
     r.predicted.high = r.predicted_relmse_spp.lo() > 0.0 ? inverse(r.predicted_relmse_spp.lo() * seconds_here)
                                                           : std::numeric_limits<double>::infinity();
-    r.predicted_rays_only = rays_only.efficiency[g];
+    r.predicted_rays_only = c.rays_only.efficiency[g];
     if (!pooled.largest_share.empty()) r.predicted_share = pooled.largest_share[g];
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     double sum = 0.0, top = 0.0;
-    for (double v : relspp[i]) sum += v, top = std::max(top, v);
-    if (relspp[i].size() > 1 && sum > 0.0) rows[i].largest_share = top / sum;
+    for (double v : runs.relmse_spp[i]) sum += v, top = std::max(top, v);
+    if (runs.relmse_spp[i].size() > 1 && sum > 0.0) rows[i].largest_share = top / sum;
   }
-  Interval predicted_optimum = interval(predicted_best);
-  predicted_optimum.mean = predicted_top >= 0 ? grid[static_cast<std::size_t>(predicted_top)] : std::nan("");
+  c.optimum = interval(c.per_seed_best);
+  c.optimum.mean = c.top >= 0 ? grid[static_cast<std::size_t>(c.top)] : std::nan("");
+  c.pooled = pooled;
+  return c;
+}
 
-  // The Must-show comparison: the predicted curve over its peak against the
-  // measured one over its fitted peak, at each row in [0.1, 0.9]; the largest
-  // gap |predicted / measured - 1|, over all those rows and over those where
-  // the measured curve is at least 0.3 of its peak (below that, a few rare
-  // paths decide the measured value); and at how many rows the prediction
-  // (scaled to the measured peak) lies inside the measured interval.
-  struct Gap {
-    double value = -1.0, at = -1.0;
-    void take(double v, double w) {
-      if (v > value) value = v, at = w;
-    }
-  } gap_all, gap_high, gap_light;
-  int gap_inside = 0, gap_rows = 0;
+// The Must-show comparison: the predicted curve over its peak against the
+// measured one over its fitted peak, at each row in [0.1, 0.9]; the largest
+// gap |predicted / measured - 1|, over all those rows and over those where
+// the measured curve is at least 0.3 of its peak (below that, a few rare
+// paths decide the measured value); and at how many rows the prediction
+// (scaled to the measured peak) lies inside the measured interval.
+struct Gap {
+  double value = -1.0, at = -1.0;
+  void take(double v, double w) {
+    if (v > value) value = v, at = w;
+  }
+};
+struct PredictionGaps {
+  Gap all, high, light;
+  int inside = 0, rows = 0;
   std::string heavy;  // the rows whose prediction one path dominates
+};
+
+PredictionGaps prediction_gaps(const std::vector<Row>& rows, const BestFixed& fair, double predicted_peak) {
+  PredictionGaps g;
   for (const Row& r : rows) {
     if (!r.unbiased || r.weight < 0.1 - 1e-9 || r.weight > 0.9 + 1e-9 || !(fair.fitted > 0.0) ||
         !(predicted_peak > 0.0) || !std::isfinite(r.predicted.mean) || !(r.efficiency.mean > 0.0))
       continue;
     const double measured = r.efficiency.mean / fair.fitted, predicted = r.predicted.mean / predicted_peak;
     const double gap = std::fabs(predicted / measured - 1.0);
-    ++gap_rows;
-    if (predicted * fair.fitted >= r.efficiency.lo() && predicted * fair.fitted <= r.efficiency.hi()) ++gap_inside;
-    gap_all.take(gap, r.weight);
-    if (measured >= 0.3) gap_high.take(gap, r.weight);
-    if (r.predicted_share <= kDominantShare) gap_light.take(gap, r.weight);
+    ++g.rows;
+    if (predicted * fair.fitted >= r.efficiency.lo() && predicted * fair.fitted <= r.efficiency.hi()) ++g.inside;
+    g.all.take(gap, r.weight);
+    if (measured >= 0.3) g.high.take(gap, r.weight);
+    if (r.predicted_share <= kDominantShare) g.light.take(gap, r.weight);
   }
   for (const Row& r : rows)
     if (r.predicted_share > kDominantShare) {
       char buf[48];
-      std::snprintf(buf, sizeof buf, "%s%.3g (%.0f%%)", heavy.empty() ? "" : ", ", r.weight, 100.0 * r.predicted_share);
-      heavy += buf;
+      std::snprintf(buf, sizeof buf, "%s%.3g (%.0f%%)", g.heavy.empty() ? "" : ", ", r.weight, 100.0 * r.predicted_share);
+      g.heavy += buf;
     }
+  return g;
+}
+
+// Auto weight's runs, pooled as a row's.
+struct AutoSummary {
+  Interval relmse_spp, efficiency, relmse, seconds;
+};
+
+AutoSummary summarise_auto(const SweepRuns& runs) {
+  return {interval(runs.auto_relmse_spp), pooled_efficiency(runs.auto_relmse_spp, runs.auto_per_sample),
+          interval(runs.auto_relmse), interval(runs.auto_seconds)};
+}
+
+// Everything the outputs are made from.
+struct SweepResult {
+  const SweepPlan& plan;
+  const SweepRuns& runs;
+  const CostFitted& cost;
+  const BestRow& best;
+  const BestFixed& fair;
+  const PredictedCurve& predicted;
+  const PredictionGaps& gaps;
+  const AutoSummary& automatic;
+};
+
+std::string sweep_csv(const SweepOptions& o, const SweepResult& s) {
+  const std::vector<Row>& rows = s.plan.rows;
+  const BestRow& b = s.best;
+  const double peak = s.predicted.peak;
   std::string csv =
       "weight,strategy,unbiased,seeds,spp,seconds,relmse,relmse_lo,relmse_hi,efficiency,efficiency_lo,efficiency_hi,"
       "relative_efficiency,samples_per_second,samples_per_second_lo,samples_per_second_hi,predicted_efficiency,"
@@ -647,93 +733,112 @@ int run_sweep(const SweepOptions& o) {
            std::to_string(o.seeds) + "," + std::to_string(r.spp) + "," + num(r.seconds.mean) + "," +
            num(r.relmse.mean) + "," + num(r.relmse.lo()) + "," + num(r.relmse.hi()) + "," + num(r.efficiency.mean) +
            "," + num(r.efficiency.lo()) + "," + num(r.efficiency.hi()) + "," +
-           num(best_efficiency > 0 ? r.efficiency.mean / best_efficiency : std::nan("")) + "," +
+           num(b.efficiency > 0 ? r.efficiency.mean / b.efficiency : std::nan("")) + "," +
            num(r.samples_per_second.mean) + "," + num(r.samples_per_second.lo()) + "," +
            num(r.samples_per_second.hi()) + "," + num(r.predicted.mean) + "," + num(r.predicted.lo()) + "," +
            num(r.predicted.hi()) + "," +
-           num(predicted_peak > 0 && r.unbiased ? r.predicted.mean / predicted_peak : std::nan("")) + "," +
-           (idx == best ? "1" : "0") + "," +
-           (best >= 0 && idx >= band_lo && idx <= band_hi ? "1" : "0") + "," + num(row_rays[i]) + "," +
-           num(row_seconds_per_sample[i]) + "," +
-           num(std::isfinite(row_rays[i]) ? cost_model.seconds(row_rays[i]) : std::nan("")) + "," +
+           num(peak > 0 && r.unbiased ? r.predicted.mean / peak : std::nan("")) + "," +
+           (idx == b.best ? "1" : "0") + "," +
+           (b.best >= 0 && idx >= b.band_lo && idx <= b.band_hi ? "1" : "0") + "," + num(s.cost.row_rays[i]) + "," +
+           num(s.cost.row_seconds_per_sample[i]) + "," +
+           num(std::isfinite(s.cost.row_rays[i]) ? s.cost.model.seconds(s.cost.row_rays[i]) : std::nan("")) + "," +
            num(r.predicted_rays_only) + "," + num(r.relmse_spp.mean) + "," + num(r.relmse_spp.lo()) + "," +
            num(r.relmse_spp.hi()) + "," + num(r.predicted_relmse_spp.mean) + "," + num(r.predicted_share) + "," +
            num(r.largest_share) + "\n";
   }
-
   if (o.auto_weight) {
+    const AutoSummary& a = s.automatic;
     std::string history;
-    for (double w : auto_weights[0]) history += (history.empty() ? "" : ">") + num(w);
-    csv += num(auto_weights[0].back()) + ",\"auto:" + history + "\",1," + std::to_string(o.seeds) + ",," +
-           num(auto_seconds.mean) + "," + num(auto_relmse.mean) + "," + num(auto_relmse.lo()) + "," +
-           num(auto_relmse.hi()) + "," + num(auto_efficiency.mean) + "," + num(auto_efficiency.lo()) + "," +
-           num(auto_efficiency.hi()) + "," +
-           num(best_efficiency > 0 ? auto_efficiency.mean / best_efficiency : std::nan("")) + ",,,,,,,,0,0,,,,," +
-           num(auto_relspp_interval.mean) + "," + num(auto_relspp_interval.lo()) + "," + num(auto_relspp_interval.hi()) +
-           ",,,\n";
+    for (double w : s.runs.auto_weights[0]) history += (history.empty() ? "" : ">") + num(w);
+    csv += num(s.runs.auto_weights[0].back()) + ",\"auto:" + history + "\",1," + std::to_string(o.seeds) + ",," +
+           num(a.seconds.mean) + "," + num(a.relmse.mean) + "," + num(a.relmse.lo()) + "," +
+           num(a.relmse.hi()) + "," + num(a.efficiency.mean) + "," + num(a.efficiency.lo()) + "," +
+           num(a.efficiency.hi()) + "," +
+           num(b.efficiency > 0 ? a.efficiency.mean / b.efficiency : std::nan("")) + ",,,,,,,,0,0,,,,," +
+           num(a.relmse_spp.mean) + "," + num(a.relmse_spp.lo()) + "," + num(a.relmse_spp.hi()) + ",,,\n";
   }
-  std::string plot;
-  if (!o.plot.empty()) {
-    PlotSeries measured;
-    measured.label = "measured (95% interval over " + std::to_string(o.seeds) + " seeds)";
-    for (const Row& r : rows) {
-      if (!r.unbiased) continue;
-      measured.x.push_back(r.weight);
-      measured.y.push_back(r.efficiency.mean);
-      measured.y_lo.push_back(r.efficiency.lo());
-      measured.y_hi.push_back(r.efficiency.hi());
-    }
-    PlotOptions po;
-    po.title = "Efficiency against the weight of " + family.a + " (vs " + family.b + "): " + scene->name;
-    po.x_label = "weight of " + family.a + " (share of " + family.a + " + " + family.b + ")";
-    po.y_label = o.cpu_time ? "efficiency = 1 / (relMSE * CPU seconds)" : "efficiency = 1 / (relMSE * seconds)";
-    po.width = 900;
-    po.height = 520;
-    po.x_min = weights.front();
-    po.x_max = weights.back();
-    if (best >= 0) {
-      po.marker_x = rows[static_cast<std::size_t>(best)].weight;
-      po.marker_lo = rows[static_cast<std::size_t>(band_lo)].weight;
-      po.marker_hi = rows[static_cast<std::size_t>(band_hi)].weight;
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "best %.3g (band %.3g..%.3g)", po.marker_x, po.marker_lo, po.marker_hi);
-      po.marker_label = buf;
-    }
-    std::vector<PlotSeries> series = {measured};
-    if (!predictions.empty()) {
-      PlotSeries predicted;
-      char buf[128];
-      std::snprintf(buf, sizeof buf, "predicted from w = %.3g (best %.3g)", rows[static_cast<std::size_t>(pilot)].weight,
-                    predicted_optimum.mean);
-      predicted.label = buf;
-      predicted.dashed = true;
-      // The weights whose prediction one path dominates drawn apart: there it
-      // is likely too high (the sweep's stdout says why).
-      PlotSeries tail;
-      char tail_label[96];
-      std::snprintf(tail_label, sizeof tail_label, "predicted, one path > %.0f%%: likely too high", 100.0 * kDominantShare);
-      tail.label = tail_label;
-      tail.dashed = true;
-      const auto dominated = [&](std::size_t i) {
-        return i < pooled.largest_share.size() && pooled.largest_share[i] > kDominantShare;
-      };
-      for (std::size_t g = 0; g < grid.size(); ++g) {
-        if (!(grid[g] >= weights.front() && grid[g] <= weights.back() && predicted_curve[g] > 0.0)) continue;
-        // A gap (NaN) in each line where the other runs; a trusted point next
-        // to a dominated one is in both, so the curve stays whole.
-        const bool here = dominated(g), beside = (g > 0 && dominated(g - 1)) || dominated(g + 1);
-        predicted.x.push_back(grid[g]), predicted.y.push_back(here ? std::nan("") : predicted_curve[g]);
-        tail.x.push_back(grid[g]), tail.y.push_back(here || beside ? predicted_curve[g] : std::nan(""));
-      }
-      series.push_back(predicted);
-      if (std::any_of(tail.y.begin(), tail.y.end(), [](double v) { return std::isfinite(v); })) series.push_back(tail);
-    }
-    plot = linear_svg(series, po);
-  }
-  write_file_atomic(o.csv, {reinterpret_cast<const std::uint8_t*>(csv.data()), csv.size()});
-  if (!o.map.empty() && !map_png.empty()) write_file_atomic(o.map, map_png);
-  if (!o.plot.empty()) write_file_atomic(o.plot, {reinterpret_cast<const std::uint8_t*>(plot.data()), plot.size()});
+  return csv;
+}
 
+std::string sweep_plot(const SweepOptions& o, const SweepResult& s) {
+  const SweepPlan& plan = s.plan;
+  const std::vector<Row>& rows = plan.rows;
+  const std::vector<double>& grid = plan.grid;
+  const BestRow& b = s.best;
+  const WeightPrediction& pooled = s.predicted.pooled;
+  const std::vector<double>& predicted_curve = pooled.efficiency;
+  PlotSeries measured;
+  measured.label = "measured (95% interval over " + std::to_string(o.seeds) + " seeds)";
+  for (const Row& r : rows) {
+    if (!r.unbiased) continue;
+    measured.x.push_back(r.weight);
+    measured.y.push_back(r.efficiency.mean);
+    measured.y_lo.push_back(r.efficiency.lo());
+    measured.y_hi.push_back(r.efficiency.hi());
+  }
+  PlotOptions po;
+  po.title = "Efficiency against the weight of " + plan.family.a + " (vs " + plan.family.b + "): " + plan.scene->name;
+  po.x_label = "weight of " + plan.family.a + " (share of " + plan.family.a + " + " + plan.family.b + ")";
+  po.y_label = o.cpu_time ? "efficiency = 1 / (relMSE * CPU seconds)" : "efficiency = 1 / (relMSE * seconds)";
+  po.width = 900;
+  po.height = 520;
+  po.x_min = plan.weights.front();
+  po.x_max = plan.weights.back();
+  if (b.best >= 0) {
+    po.marker_x = rows[static_cast<std::size_t>(b.best)].weight;
+    po.marker_lo = rows[static_cast<std::size_t>(b.band_lo)].weight;
+    po.marker_hi = rows[static_cast<std::size_t>(b.band_hi)].weight;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "best %.3g (band %.3g..%.3g)", po.marker_x, po.marker_lo, po.marker_hi);
+    po.marker_label = buf;
+  }
+  std::vector<PlotSeries> series = {measured};
+  if (!s.runs.predictions.empty()) {
+    PlotSeries predicted;
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "predicted from w = %.3g (best %.3g)", rows[static_cast<std::size_t>(plan.pilot)].weight,
+                  s.predicted.optimum.mean);
+    predicted.label = buf;
+    predicted.dashed = true;
+    // The weights whose prediction one path dominates drawn apart: there it
+    // is likely too high (the sweep's stdout says why).
+    PlotSeries tail;
+    char tail_label[96];
+    std::snprintf(tail_label, sizeof tail_label, "predicted, one path > %.0f%%: likely too high", 100.0 * kDominantShare);
+    tail.label = tail_label;
+    tail.dashed = true;
+    const auto dominated = [&](std::size_t i) {
+      return i < pooled.largest_share.size() && pooled.largest_share[i] > kDominantShare;
+    };
+    for (std::size_t g = 0; g < grid.size(); ++g) {
+      if (!(grid[g] >= plan.weights.front() && grid[g] <= plan.weights.back() && predicted_curve[g] > 0.0)) continue;
+      // A gap (NaN) in each line where the other runs; a trusted point next
+      // to a dominated one is in both, so the curve stays whole.
+      const bool here = dominated(g), beside = (g > 0 && dominated(g - 1)) || dominated(g + 1);
+      predicted.x.push_back(grid[g]), predicted.y.push_back(here ? std::nan("") : predicted_curve[g]);
+      tail.x.push_back(grid[g]), tail.y.push_back(here || beside ? predicted_curve[g] : std::nan(""));
+    }
+    series.push_back(predicted);
+    if (std::any_of(tail.y.begin(), tail.y.end(), [](double v) { return std::isfinite(v); })) series.push_back(tail);
+  }
+  return linear_svg(series, po);
+}
+
+void write_sweep_files(const SweepOptions& o, const SweepResult& s) {
+  const std::string csv = sweep_csv(o, s);
+  const std::string plot = o.plot.empty() ? std::string() : sweep_plot(o, s);
+  write_file_atomic(o.csv, {reinterpret_cast<const std::uint8_t*>(csv.data()), csv.size()});
+  if (!o.map.empty() && !s.runs.map_png.empty()) write_file_atomic(o.map, s.runs.map_png);
+  if (!o.plot.empty()) write_file_atomic(o.plot, {reinterpret_cast<const std::uint8_t*>(plot.data()), plot.size()});
+}
+
+void print_sweep_table(const SweepOptions& o, const SweepResult& s, double load_at_start) {
+  const SweepPlan& plan = s.plan;
+  const std::vector<Row>& rows = plan.rows;
+  const BestRow& b = s.best;
+  const BestFixed& fair = s.fair;
+  const CostModel& cost_model = s.cost.model;
+  const PredictionGaps& gaps = s.gaps;
   std::printf("%-8s %-40s %6s %10s %22s %10s %11s %9s\n", "weight", "strategy", "spp", "relmse", "efficiency (95%)",
               "vs best", "predicted", "Msamp/s");
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -741,64 +846,85 @@ int run_sweep(const SweepOptions& o) {
     char eff_text[64];
     std::snprintf(eff_text, sizeof eff_text, "%.4g [%.3g, %.3g]", r.efficiency.mean, r.efficiency.lo(), r.efficiency.hi());
     std::printf("%-8.3g %-40s %6u %10.4g %22s %9.2fx %11.4g %9.3f%s%s\n", r.weight, r.strategy.to_string().c_str(),
-                r.spp, r.relmse.mean, eff_text, best_efficiency > 0 ? r.efficiency.mean / best_efficiency : 0.0,
+                r.spp, r.relmse.mean, eff_text, b.efficiency > 0 ? r.efficiency.mean / b.efficiency : 0.0,
                 r.predicted.mean, r.samples_per_second.mean * 1e-6, r.unbiased ? "" : "  (biased)",
-                static_cast<int>(i) == best ? "  <- best" : "");
+                static_cast<int>(i) == b.best ? "  <- best" : "");
   }
-  if (best >= 0)
-    std::printf("best weight of %s: %.3g; indistinguishable at 95%%: %.3g..%.3g\n", family.a.c_str(),
-                rows[static_cast<std::size_t>(best)].weight, rows[static_cast<std::size_t>(band_lo)].weight,
-                rows[static_cast<std::size_t>(band_hi)].weight);
+  if (b.best >= 0)
+    std::printf("best weight of %s: %.3g; indistinguishable at 95%%: %.3g..%.3g\n", plan.family.a.c_str(),
+                rows[static_cast<std::size_t>(b.best)].weight, rows[static_cast<std::size_t>(b.band_lo)].weight,
+                rows[static_cast<std::size_t>(b.band_hi)].weight);
   else
     std::printf("no weight of the sweep gives an unbiased mixture\n");
-  if (best >= 0)
+  if (b.best >= 0)
     std::printf("best fixed weight's efficiency, fairly: %.4g at %.3g (the parabola through the rows within 0.2), "
                 "%.4g (chosen on half the seeds, measured on the others); the best row's mean %.4g\n",
-                fair.fitted, fair.fitted_weight, fair.held_out, best_efficiency);
+                fair.fitted, fair.fitted_weight, fair.held_out, b.efficiency);
   if (cost_model.per_ray > 0.0)
     std::printf("cost model: seconds per sample = %.4g + %.4g x rays (a fixed cost of %.2f rays; %s)\n",
                 cost_model.per_sample, cost_model.per_ray, cost_model.offset(),
                 cost_model.fitted ? "fitted to the rows' timing" : "too little spread to fit: the prior");
   if (o.auto_weight) {
+    const Interval& auto_efficiency = s.automatic.efficiency;
     std::printf("auto weight against the fair best fixed: %.0f%% (%.0f..%.0f%%) of the fitted, %.0f%% of the held-out;"
                 " its fitted fixed costs, rays:",
                 fair.fitted > 0 ? 100.0 * auto_efficiency.mean / fair.fitted : 0.0,
                 fair.fitted > 0 ? 100.0 * auto_efficiency.lo() / fair.fitted : 0.0,
                 fair.fitted > 0 ? 100.0 * auto_efficiency.hi() / fair.fitted : 0.0,
                 fair.held_out > 0 ? 100.0 * auto_efficiency.mean / fair.held_out : 0.0);
-    for (double v : auto_offset) std::printf(" %.2f", v);
+    for (double v : s.runs.auto_offset) std::printf(" %.2f", v);
     std::printf("\n");
     std::printf("auto weight: efficiency %.4g [%.3g, %.3g], %.0f%% of the best fixed weight's; weights per pass:",
                 auto_efficiency.mean, auto_efficiency.lo(), auto_efficiency.hi(),
-                best_efficiency > 0 ? 100.0 * auto_efficiency.mean / best_efficiency : 0.0);
-    for (const auto& h : auto_weights) {
+                b.efficiency > 0 ? 100.0 * auto_efficiency.mean / b.efficiency : 0.0);
+    for (const auto& h : s.runs.auto_weights) {
       std::printf(" ");
       for (std::size_t i = 0; i < h.size(); ++i) std::printf("%s%.3g", i ? ">" : "", h[i]);
     }
     std::printf("\n");
   }
-  if (!predictions.empty())
+  if (!s.runs.predictions.empty())
     std::printf("predicted best weight (from the paths at %.3g, %zu seeds pooled): %.3g; each seed's alone: %.3g +- %.2g\n",
-                rows[static_cast<std::size_t>(pilot)].weight, predictions.size(), predicted_optimum.mean,
-                interval(predicted_best).mean, predicted_optimum.half);
+                rows[static_cast<std::size_t>(plan.pilot)].weight, s.runs.predictions.size(), s.predicted.optimum.mean,
+                interval(s.predicted.per_seed_best).mean, s.predicted.optimum.half);
   else
     std::printf("no prediction: no weight of the sweep lies inside [%.2g, %.2g]\n", kDefensiveFloor,
                 1.0 - kDefensiveFloor);
-  if (gap_rows > 0)
+  if (gaps.rows > 0)
     std::printf("predicted relative efficiency against measured, %d weights in [0.1, 0.9]: largest gap %.0f%% (at %.3g); "
                 "%.0f%% (at %.3g) where measured is at least 0.3 of its peak; inside the measured 95%% interval at %d of %d\n",
-                gap_rows, 100.0 * gap_all.value, gap_all.at, 100.0 * std::max(0.0, gap_high.value), gap_high.at,
-                gap_inside, gap_rows);
-  if (gap_light.value >= 0.0)
+                gaps.rows, 100.0 * gaps.all.value, gaps.all.at, 100.0 * std::max(0.0, gaps.high.value), gaps.high.at,
+                gaps.inside, gaps.rows);
+  if (gaps.light.value >= 0.0)
     std::printf("  where no single path carries more than %.0f%% of the predicted second moment: largest gap %.0f%% (at %.3g)\n",
-                100.0 * kDominantShare, 100.0 * gap_light.value, gap_light.at);
-  if (!heavy.empty())
+                100.0 * kDominantShare, 100.0 * gaps.light.value, gaps.light.at);
+  if (!gaps.heavy.empty())
     std::printf("one path carries more than %.0f%% of the predicted second moment at %s: there the moment is infinite or "
                 "carried by paths too rare for the runs to hold, so the predicted and the measured efficiency are "
                 "likely too high\n",
-                100.0 * kDominantShare, heavy.c_str());
+                100.0 * kDominantShare, gaps.heavy.c_str());
   std::printf("load average (1 min): %.2f at the start, %.2f at the end; runs priced by %s\n", load_at_start,
               load_average(), o.cpu_time ? "their CPU time (--cpu-time)" : "the wall clock");
+}
+
+}  // namespace
+
+int run_sweep(const SweepOptions& o) {
+  check_comparison_options(o, {o.map});
+  if (o.seeds < 1 || o.seeds > 1000) throw InputError("--seeds must be in 1..1000");
+  SweepPlan plan = plan_sweep(o);
+  const double load_at_start = load_average();
+  SweepRuns runs = run_sweep_runs(plan, o);
+  summarise_rows(plan.rows, runs);
+  CostFitted cost = fit_cost(plan, runs);
+  const AutoSummary automatic = summarise_auto(runs);
+  const BestRow best = best_row(plan.rows);
+  const BestFixed fair = fair_best_fixed(plan.rows, runs.relmse_spp, runs.per_sample, best.best);
+  const PredictedCurve predicted = predict_rows(plan, runs, cost);
+  const PredictionGaps gaps = prediction_gaps(plan.rows, fair, predicted.peak);
+  const SweepResult result{plan, runs, cost, best, fair, predicted, gaps, automatic};
+  write_sweep_files(o, result);
+  print_sweep_table(o, result, load_at_start);
   return 0;
 }
 

@@ -9,18 +9,26 @@
 #
 # RENDER_OPTIONS are given to every `pdflab render` (--scene, --strategy,
 # --seed, --width, --height, ...). Range k of K covers the sample indices
-# [k*N/K, (k+1)*N/K). Each part is a film in DIR (default: a new temporary
-# folder, removed afterwards), so a failed part can be rendered again alone.
-# With --sshlogin (GNU parallel's syntax, e.g. "4/alice@m1,4/alice@m2,:"),
-# every machine must see pdflab, the scene and DIR at the same paths (a shared
-# folder). PDFLAB names the binary (default: build/release/app/pdflab).
+# [k*N/K, (k+1)*N/K). A part renders to DIR/partial-FIRST.film and becomes
+# DIR/part-FIRST.film only when it is whole; the merge refuses anything but
+# the whole [0, N) (merge --expect-spp). When a part fails the others go on,
+# DIR is kept and the command to continue is printed: the same command with
+# --parts DIR renders only what is missing, resuming the partial films.
+# DIR defaults to a new temporary folder, removed after a successful merge.
+# With --sshlogin (GNU parallel's syntax, e.g. "alice@m1,alice@m2,:"), each
+# machine runs one part at a time on all its cores (--threads to change),
+# every job starts in this folder, so relative paths work, and every machine
+# must see this folder, pdflab and the scene at the same paths (a shared
+# folder, e.g. NFS); DIR then defaults to a new folder in this one.
+# PDFLAB names the binary (default: build/release/app/pdflab).
 set -euo pipefail
 
 usage() {
-  sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 
+invocation=("$0" "$@")
 jobs="" spp="" out="" film_out="" parts="" sshlogin="" threads=""
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -41,6 +49,7 @@ is_count() { [[ "$1" =~ ^[1-9][0-9]*$ ]]; }
 is_count "$jobs" || { echo "render_parallel.sh: --jobs must be a positive integer" >&2; exit 2; }
 is_count "$spp" || { echo "render_parallel.sh: --spp must be a positive integer" >&2; exit 2; }
 [ "$spp" -ge "$jobs" ] || { echo "render_parallel.sh: --spp ($spp) must be at least --jobs ($jobs)" >&2; exit 2; }
+[ -z "$threads" ] || [[ "$threads" =~ ^[0-9]+$ ]] || { echo "render_parallel.sh: --threads must be an integer >= 0" >&2; exit 2; }
 [ -n "$out" ] || [ -n "$film_out" ] || { echo "render_parallel.sh: give --out, --film-out or both" >&2; exit 2; }
 command -v parallel >/dev/null || { echo "render_parallel.sh: GNU parallel is not installed (apt-get install parallel)" >&2; exit 2; }
 
@@ -48,7 +57,21 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 pdflab=${PDFLAB:-$here/build/release/app/pdflab}
 [ -x "$pdflab" ] || { echo "render_parallel.sh: no pdflab binary at $pdflab (build it, or set PDFLAB)" >&2; exit 2; }
 
-# Local jobs share this machine's cores; remote ones use all of theirs.
+# Local jobs share this machine's cores; a machine reached by ssh runs one part
+# at a time on all of its own (job slots asked for in LOGINS, N/login, are
+# dropped: several parts on one machine would each take every core).
+if [ -n "$sshlogin" ]; then
+  logins=()
+  IFS=',' read -r -a given <<<"$sshlogin"
+  for login in "${given[@]}"; do
+    if [[ "$login" =~ ^[0-9]+/(.*)$ ]]; then
+      echo "render_parallel.sh: note: '$login': one part at a time per machine, on all its cores" >&2
+      login=${BASH_REMATCH[1]}
+    fi
+    logins+=("$login")
+  done
+  sshlogin=$(IFS=','; echo "${logins[*]}")
+fi
 if [ -z "$threads" ]; then
   if [ -z "$sshlogin" ]; then
     threads=$(( $(nproc) / jobs ))
@@ -58,13 +81,28 @@ if [ -z "$threads" ]; then
   fi
 fi
 
-cleanup_parts=""
+temporary_parts=""
 if [ -z "$parts" ]; then
-  parts=$(mktemp -d "${TMPDIR:-/tmp}/pdflab-parts-XXXXXX")
-  cleanup_parts=$parts
+  if [ -z "$sshlogin" ]; then
+    parts=$(mktemp -d "${TMPDIR:-/tmp}/pdflab-parts-XXXXXX")
+  else
+    parts=$(mktemp -d "$PWD/pdflab-parts-XXXXXX")  # here: the machines share this folder, not /tmp
+  fi
+  temporary_parts=$parts
 fi
 mkdir -p "$parts"
-trap '[ -z "$cleanup_parts" ] || rm -rf "$cleanup_parts"' EXIT
+
+# A parts folder belongs to one render: the same samples, parts and options.
+# Another render's parts would be resumed or merged as this one's.
+layout="spp=$spp jobs=$jobs render:$(printf ' %q' "${render_args[@]}")"
+if [ -f "$parts/layout" ]; then
+  if [ "$(cat "$parts/layout")" != "$layout" ]; then
+    echo "render_parallel.sh: '$parts' holds the parts of another render ($(cat "$parts/layout")); give another --parts folder" >&2
+    exit 2
+  fi
+else
+  printf '%s\n' "$layout" >"$parts/layout.tmp.$$" && mv -f "$parts/layout.tmp.$$" "$parts/layout"
+fi
 
 starts=() counts=()
 for ((k = 0; k < jobs; k++)); do
@@ -74,21 +112,58 @@ for ((k = 0; k < jobs; k++)); do
   counts+=("$(( end - first ))")
 done
 
-parallel_args=(--will-cite --halt now,fail=1 --line-buffer -q)
+# The same command with --parts: it renders only what is missing.
+print_continue() {
+  echo "render_parallel.sh: what the parts rendered is in $parts (partial-*.film: stopped early); continue with:" >&2
+  local cont=("${invocation[@]}")
+  [ -z "$temporary_parts" ] || cont=("$0" --parts "$parts" "${invocation[@]:1}")
+  printf ' %q' "${cont[@]}" >&2
+  echo >&2
+}
+trap 'echo >&2; print_continue; exit 130' INT TERM
+
+# One part, run by bash on whichever machine GNU parallel chooses: in this
+# folder, a whole part is kept, a partial one resumed (pdflab checks that it
+# is this render's: scene, strategy, seed, size, first sample), a missing one
+# rendered; only a part that reached its count takes its final name.
+# shellcheck disable=SC2016 # expanded by the job's shell
+part_job='dir=$1 pdflab=$2 parts=$3 first=$4 count=$5 threads=$6; shift 6;
+cd "$dir" 2>/dev/null || { echo "render_parallel.sh: $(hostname): no folder $dir here (every machine must see it at the same path)" >&2; exit 3; };
+whole=$parts/part-$first.film; partial=$parts/partial-$first.film;
+[ -f "$whole" ] && exit 0;
+if [ -f "$partial" ]; then "$pdflab" render --resume "$partial" "$@" --first-sample "$first" --spp "$count" --threads "$threads" --quiet || exit;
+else "$pdflab" render "$@" --first-sample "$first" --spp "$count" --film-out "$partial" --threads "$threads" --quiet || exit; fi;
+mv -f "$partial" "$whole"'
+part_job=${part_job//$'\n'/ }
+
+parallel_args=(--will-cite --line-buffer -q)
 if [ -n "$sshlogin" ]; then
-  parallel_args+=(--sshlogin "$sshlogin")
+  parallel_args+=(--sshlogin "$sshlogin" --jobs 1)
 else
   parallel_args+=(--jobs "$jobs")
 fi
 # -q hands each argument over unchanged (no shell word splitting of paths).
+# Every part runs even when one fails: what the others render is kept.
+failed=0
 parallel "${parallel_args[@]}" \
-  "$pdflab" render "${render_args[@]}" --threads "$threads" --quiet \
-  --first-sample '{1}' --spp '{2}' --film-out "$parts/part-{1}.film" \
-  ::: "${starts[@]}" :::+ "${counts[@]}"
+  bash -c "$part_job" pdflab-part "$PWD" "$pdflab" "$parts" '{1}' '{2}' "$threads" "${render_args[@]}" \
+  ::: "${starts[@]}" :::+ "${counts[@]}" || failed=$?
 
-merge_args=()
+missing=()
+for first in "${starts[@]}"; do [ -f "$parts/part-$first.film" ] || missing+=("$first"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "render_parallel.sh: ${#missing[@]} of $jobs parts did not finish (first samples: ${missing[*]}; GNU parallel status $failed)." >&2
+  print_continue
+  exit 1
+fi
+
+merge_args=(--expect-spp "$spp")
 [ -z "$out" ] || merge_args+=(--out "$out")
 [ -z "$film_out" ] || merge_args+=(--film-out "$film_out")
 films=()
 for first in "${starts[@]}"; do films+=("$parts/part-$first.film"); done
-"$pdflab" merge "${films[@]}" "${merge_args[@]}"
+"$pdflab" merge "${films[@]}" "${merge_args[@]}" || {
+  echo "render_parallel.sh: the merge failed; the parts are kept in $parts" >&2
+  exit 1
+}
+[ -z "$temporary_parts" ] || rm -rf "$temporary_parts"

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -24,6 +25,26 @@
 #include <vector>
 
 namespace pdflab::testing {
+
+// The build these tests and the pdflab binary beside them come from. A
+// sanitizer build renders 10-30x slower than a release build (ASan: about
+// 0.09 M samples/s on the book's box on a loaded 2-core machine, against
+// 15 M), an unoptimised one several times slower: tests size their work in
+// samples for the build (spp_for_build) and give children deadlines that
+// hold on such a machine (deadline_for_build), never a release build's
+// seconds.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__OPTIMIZE__)
+inline constexpr bool kSlowBuild = true;
+#else
+inline constexpr bool kSlowBuild = false;
+#endif
+
+// `release` samples per pixel in a release build, `slow` in a sanitizer or
+// unoptimised one (chosen to test the same property).
+constexpr std::uint32_t spp_for_build(std::uint32_t release, std::uint32_t slow) { return kSlowBuild ? slow : release; }
+// A child's deadline: `release_seconds` already allows for a loaded machine;
+// a slow build gets ten times that.
+constexpr double deadline_for_build(double release_seconds) { return kSlowBuild ? 10.0 * release_seconds : release_seconds; }
 
 // A fresh empty folder, removed with everything in it when the object goes.
 class TempDir {
@@ -150,13 +171,14 @@ class CommandWorkspace {
   std::string in_work(const std::string& name) const { return (work() / name).string(); }
   std::vector<std::string> work_entries() const { return listing(work()); }
   // The binary itself (no shell), stdin from /dev/null, in the working folder.
-  ChildResult run(const std::vector<std::string>& args, double deadline_seconds = 120.0) const {
+  ChildResult run(const std::vector<std::string>& args, double deadline_seconds = deadline_for_build(120.0)) const {
     ChildOptions o;
     o.cwd = work();
     o.capture = root_.path() / "io";
     o.deadline_seconds = deadline_seconds;
     return run_pdflab(args, o);
   }
+  const std::filesystem::path& root() const { return root_.path(); }
 
  private:
   TempDir root_;

@@ -267,7 +267,7 @@ TEST_F(BenchCommand, TinyRunWritesTheTablesAndAPlot) {
     EXPECT_EQ(last_spp, "16") << s;
   }
 
-  EXPECT_EQ(work_entries(), (std::vector<std::string>{"curves.csv", "out.csv", "out.svg", "ref.pfm"}));
+  EXPECT_EQ(work_entries(), (std::vector<std::string>{"curves.csv", "out.csv", "out.svg", "ref.json", "ref.pfm"}));
 }
 
 // --predict: every mixture of the pair gets its weight and the efficiency

@@ -158,7 +158,14 @@ TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   const ChildResult r = run(small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json"), "--seed", "5"}));
   ASSERT_TRUE(r.exited);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(work_entries(), (std::vector<std::string>{"image.pfm", "stats.json"}));
+  // The PFM's sidecar says what it is an estimate of (issue 33, item 5).
+  EXPECT_EQ(work_entries(), (std::vector<std::string>{"image.json", "image.pfm", "stats.json"}));
+  const nlohmann::json sidecar = nlohmann::json::parse(slurp(work() / "image.json"));
+  EXPECT_EQ(sidecar.at("format").get<std::string>(), "pdflab-render");
+  EXPECT_EQ(sidecar.at("seed").get<int>(), 5);
+  EXPECT_EQ(sidecar.at("seeds"), nlohmann::json::array({5}));
+  EXPECT_EQ(sidecar.at("sample_ranges").get<std::string>(), "seed 5 samples [0, 4)");
+  EXPECT_EQ(sidecar.at("strategy").get<std::string>(), "mix:cosine=0.5,light=0.5");
 
   int w = 0, h = 0;
   const std::vector<float> rgb = read_pfm(in_work("image.pfm"), w, h);
@@ -230,6 +237,96 @@ TEST_F(RenderCommand, RendersPng) {
   EXPECT_EQ(u32(20), 32u);
   EXPECT_NE(r.out.find("4 spp"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("M samples/s"), std::string::npos) << r.out;
+}
+
+// A PFM's sidecar may replace an earlier sidecar, never the scene (box.json
+// beside box.pfm) or another file; with --stats-json naming it, the stats
+// JSON is the sidecar.
+TEST_F(RenderCommand, APfmSidecarNeverReplacesAnotherFile) {
+  const std::string scene = in_work("box.json");
+  {
+    std::ofstream(scene) << slurp(kBookScene);
+  }
+  const std::string before = slurp(scene);
+  const auto render = [&](const std::string& out, std::initializer_list<std::string> extra = {}) {
+    std::vector<std::string> a = small_render(out, extra);
+    a[2] = scene;
+    return run(a);
+  };
+  ChildResult r = render(in_work("box.pfm"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("would replace the scene file"), std::string::npos) << r.err;
+  {
+    std::ofstream(in_work("notes.json")) << "{\"mine\": true}";
+  }
+  r = render(in_work("notes.pfm"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("not a pdflab sidecar"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(scene), before);
+  EXPECT_EQ(work_entries(), (std::vector<std::string>{"box.json", "notes.json"})) << "refused before rendering";
+  r = render(in_work("image.pfm"), {"--stats-json", in_work("image.json")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(work() / "image.json"));
+  EXPECT_EQ(j.at("seeds"), nlohmann::json::array({1}));
+  EXPECT_TRUE(j.contains("samples_per_second")) << "the stats JSON is the sidecar";
+  ASSERT_EQ(render(in_work("image.pfm")).status, 0) << "an earlier sidecar is replaced";
+}
+
+// Issue 33, item 7: whether "the estimate is unreliable" is printed depends
+// on the samples, not on when the render's polls fell: the estimate is taken
+// at each power of two and at the end, the same figures on one thread or two.
+TEST_F(RenderCommand, TheEstimateVerdictDependsOnTheSamplesNotTheTiming) {
+  const std::string small_light = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/small_light.json";
+  nlohmann::json first;
+  for (const char* threads : {"1", "2", "1", "2"}) {
+    const ChildResult r = run({"render", "--scene", small_light, "--strategy", "cosine", "--width", "24", "--height",
+                               "24", "--spp", "300", "--threads", threads, "--quiet", "--out", in_work("i.pfm"),
+                               "--stats-json", in_work("s.json")});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json s = nlohmann::json::parse(slurp(work() / "s.json"));
+    const nlohmann::json figures = {s.at("est_relmse_history"), s.at("est_relmse_unreliable"), s.at("est_relmse")};
+    EXPECT_EQ(s.at("est_relmse_unreliable").get<bool>(), r.out.find("estimate is unreliable") != std::string::npos);
+    if (first.is_null()) first = figures;
+    EXPECT_EQ(figures, first) << "threads " << threads;
+  }
+  // Points at 2, 4, ..., 256 and 300.
+  ASSERT_EQ(first[0].size(), 9u) << first[0];
+  EXPECT_EQ(first[0].back()[0], 300);
+  EXPECT_EQ(first[0][0][0], 2);
+  std::printf("4 renders: the same history and verdict (unreliable: %s)\n", first[1].get<bool>() ? "yes" : "no");
+}
+
+// Issue 33, item 8: every --reference help names what load_reference reads.
+TEST_F(RenderCommand, EveryReferenceHelpNamesPfmExrAndFilm) {
+  for (const std::vector<std::string>& help : {std::vector<std::string>{"--help"}, {"render", "--help"},
+                                               {"bench", "--help"}, {"sweep", "--help"}}) {
+    const ChildResult r = run(help);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::size_t at = r.out.find("--reference ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+    EXPECT_NE(line.find(".pfm, .exr or .film"), std::string::npos) << help[0] << ": " << line;
+  }
+}
+
+// Issue 33, item 8: docs/measuring.md says what the commands do: sweep's
+// --seeds default, and a cached reference the viewer finds (the cache is
+// keyed by size: a 300x300 reference is not found for the 600x600 view).
+TEST_F(RenderCommand, MeasuringDocAgreesWithTheCommands) {
+  const std::string doc = slurp(std::string(PDFLAB_SOURCE_DIR) + "/docs/measuring.md");
+  const ChildResult sweep = run({"sweep", "--help"});
+  const std::size_t seeds = sweep.out.find("--seeds");
+  ASSERT_NE(seeds, std::string::npos);
+  const std::size_t open = sweep.out.find("(default ", seeds);
+  const std::string dflt = sweep.out.substr(open + 9, sweep.out.find(')', open) - open - 9);
+  EXPECT_EQ(dflt, "3");
+  const std::size_t bullet = doc.find("Each weight is rendered `--seeds K` times");
+  ASSERT_NE(bullet, std::string::npos);
+  EXPECT_NE(doc.substr(bullet, 200).find("default " + dflt + ";"), std::string::npos) << doc.substr(bullet, 200);
+  const std::size_t example = doc.find("pdflab reference --scene assets/scenes/cornell_book.json");
+  ASSERT_NE(example, std::string::npos);
+  const std::string line = doc.substr(example, doc.find('\n', example) - example);
+  EXPECT_EQ(line.find("--width"), std::string::npos) << "the viewer renders the scene's 600x600: " << line;
 }
 
 TEST_F(RenderCommand, RendersHdr) {

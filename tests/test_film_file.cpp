@@ -7,6 +7,7 @@
 #include "renderer/film/exr_io.h"
 #include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/metrics/reference.h"
 #include "renderer/scene/scene_loader.h"
 #include "tests/render_support.h"
 #include "tests/support.h"
@@ -15,6 +16,9 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <sys/stat.h>
+#include <zlib.h>
 
 #include <gtest/gtest.h>
 
@@ -227,9 +231,9 @@ TEST_F(FilmFileTest, DamagedTruncatedAndForeignFilesAreRefused) {
   expect_refused(bad, "not a pdflab film");
 
   std::string damaged = good;
-  damaged[8] = 2;  // the version
+  damaged[8] = 3;  // the version
   write_bytes(bad, damaged);
-  expect_refused(bad, "version 2");
+  expect_refused(bad, "version 3");
   damaged = good;
   damaged[20] ^= 0x01;  // the width, inside the header's checksum
   write_bytes(bad, damaged);
@@ -248,9 +252,72 @@ TEST_F(FilmFileTest, DamagedTruncatedAndForeignFilesAreRefused) {
     ++refused;
   }
   expect_refused(dir_.file("missing.film"), "cannot read");
-  expect_refused(dir_.path().string(), "not a regular file");
+  expect_refused(dir_.path().string(), "is a folder");
   std::printf("%d truncated prefixes and 9 damaged or foreign files refused\n", refused);
   EXPECT_NO_THROW((void)read_film_file(good_path));
+}
+
+// Issue 33, item 13: the data's checksum runs on from the header's, so one
+// film's header on another's data (of the same size: A's ranges claimed for
+// B's samples, merging B twice) is refused; a version 1 film, whose data
+// checksum starts afresh, is still read.
+TEST_F(FilmFileTest, HeaderIsUnderTheDataChecksumAndVersionOneStillReads) {
+  const auto scene = small_scene(8, 4);
+  const auto a = render_to_completion(scene, kMix, 4, 1, 1, kTimeout, 0);
+  const auto b = render_to_completion(scene, kMix, 4, 1, 1, kTimeout, 4);
+  write_film_file(dir_.file("a.film"), describe(*scene, kMix, 1, 0, 4), a.film);
+  write_film_file(dir_.file("b.film"), describe(*scene, kMix, 1, 4, 4), b.film);
+  const std::string fa = slurp(dir_.file("a.film")), fb = slurp(dir_.file("b.film"));
+  std::uint32_t header = 0;
+  std::memcpy(&header, fa.data() + 12, 4);
+  const std::size_t data_start = 16 + header + 4;
+  ASSERT_EQ(fa.size(), fb.size());
+  // A's preamble, header and header checksum; B's data and data checksum.
+  write_bytes(dir_.file("swapped.film"), fa.substr(0, data_start) + fb.substr(data_start));
+  expect_refused(dir_.file("swapped.film"), "data's checksum");
+
+  // The same film as version 1 wrote it: version 1, the header's CRC over it,
+  // the data's CRC from zero.
+  std::string v1 = fa;
+  v1[8] = 1;
+  const auto head_crc = static_cast<std::uint32_t>(crc32_z(0, reinterpret_cast<const Bytef*>(v1.data()), 16 + header));
+  std::memcpy(v1.data() + 16 + header, &head_crc, 4);
+  const auto data_crc = static_cast<std::uint32_t>(
+      crc32_z(0, reinterpret_cast<const Bytef*>(v1.data() + data_start), v1.size() - data_start - 4));
+  std::memcpy(v1.data() + v1.size() - 4, &data_crc, 4);
+  write_bytes(dir_.file("v1.film"), v1);
+  FilmFile old;
+  ASSERT_NO_THROW(old = read_film_file(dir_.file("v1.film")));
+  EXPECT_EQ(old.film.sums(), a.film.sums());
+  EXPECT_EQ(old.info.ranges, describe(*scene, kMix, 1, 0, 4).ranges);
+}
+
+// The fuzzer's seeds (tests/fuzz/film_seeds/) are films of both versions
+// that read: a mutation starts from a valid film.
+TEST_F(FilmFileTest, EveryFuzzSeedReads) {
+  int versions[3] = {0, 0, 0};
+  for (const auto& e : std::filesystem::directory_iterator(std::string(PDFLAB_SOURCE_DIR) + "/tests/fuzz/film_seeds")) {
+    SCOPED_TRACE(e.path().filename().string());
+    EXPECT_NO_THROW((void)read_film_file(e.path().string()));
+    const std::string bytes = slurp(e.path());
+    ASSERT_GE(bytes.size(), 12u);
+    ++versions[std::min<int>(2, static_cast<unsigned char>(bytes[8]))];
+  }
+  EXPECT_GT(versions[1], 0) << "a version 1 seed";
+  EXPECT_GT(versions[2], 0) << "a version 2 seed";
+}
+
+// Issue 33, item 10: a named pipe given as a film is refused at once (open()
+// of a FIFO for reading waits for a writer: forever, in a batch job).
+TEST_F(FilmFileTest, AFifoIsRefusedWithoutWaiting) {
+  const std::string fifo = dir_.file("pipe.film");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto start = std::chrono::steady_clock::now();
+  expect_refused(fifo, "pipe (FIFO)");
+  int w = 0, h = 0;
+  EXPECT_THROW((void)read_pfm(fifo, w, h), InputError);
+  EXPECT_THROW((void)read_exr(fifo, w, h), InputError);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);
 }
 
 // The EXR as OpenEXR reads it, channel by channel, against the film.
@@ -266,14 +333,15 @@ TEST_F(FilmFileTest, ExrHoldsMeanVarianceAndCountAsOpenExrReadsThem) {
     ASSERT_NE(channels.findChannel(name), nullptr) << name;
     EXPECT_EQ(channels.findChannel(name)->type, Imf::FLOAT) << name;
   }
+  // A float count (exact to 2^24): image tools read an unsigned one as a fraction of 2^32.
   ASSERT_NE(channels.findChannel("count"), nullptr);
-  EXPECT_EQ(channels.findChannel("count")->type, Imf::UINT);
+  EXPECT_EQ(channels.findChannel("count")->type, Imf::FLOAT);
   const auto dw = in.header().dataWindow();
   ASSERT_EQ(dw.max.x - dw.min.x + 1, 20);
   ASSERT_EQ(dw.max.y - dw.min.y + 1, 37);
   const std::size_t n = r.film.pixel_count();
   std::vector<float> mean(3 * n), variance(3 * n);
-  std::vector<std::uint32_t> count(n);
+  std::vector<float> count(n);
   Imf::FrameBuffer fb;
   const char* mean_names[3] = {"R", "G", "B"};
   const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
@@ -281,13 +349,13 @@ TEST_F(FilmFileTest, ExrHoldsMeanVarianceAndCountAsOpenExrReadsThem) {
     fb.insert(mean_names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(mean.data() + c), 12, 12 * 20));
     fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(variance.data() + c), 12, 12 * 20));
   }
-  fb.insert("count", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(count.data()), 4, 4 * 20));
+  fb.insert("count", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(count.data()), 4, 4 * 20));
   in.setFrameBuffer(fb);
   in.readPixels(dw.min.y, dw.max.y);
   for (std::size_t p = 0; p < n; ++p) {
     double m[3], v[3];
     r.film.moments(p, Film::reciprocals(r.film.count(p)), m, v);
-    ASSERT_EQ(count[p], 8u);
+    ASSERT_EQ(count[p], 8.0f);
     for (std::size_t c = 0; c < 3; ++c) {
       ASSERT_EQ(mean[3 * p + c], static_cast<float>(m[c])) << "pixel " << p;
       ASSERT_EQ(variance[3 * p + c], static_cast<float>(v[c])) << "pixel " << p;
@@ -300,6 +368,35 @@ TEST_F(FilmFileTest, ExrHoldsMeanVarianceAndCountAsOpenExrReadsThem) {
   // And the PFM streamed from the film is the same mean, bit for bit.
   write_film_image(dir_.file("image.pfm"), r.film);
   EXPECT_EQ(read_pfm(dir_.file("image.pfm"), w, h), r.film.mean_rgb());
+}
+
+// Issue 33, item 11: an EXR with part of a layer (R and B without G, one
+// variance channel) is refused, naming what is missing; it read as 0 before.
+TEST_F(FilmFileTest, ExrWithPartOfALayerIsRefused) {
+  const auto write_channels = [&](const std::string& path, const std::vector<const char*>& names) {
+    Imf::Header header(2, 2);
+    for (const char* c : names) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    std::vector<float> values(4, 0.5f);
+    Imf::OutputFile out(path.c_str(), header);
+    Imf::FrameBuffer fb;
+    for (const char* c : names) fb.insert(c, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(values.data()), 4, 8));
+    out.setFrameBuffer(fb);
+    out.writePixels(2);
+  };
+  int w = 0, h = 0;
+  write_channels(dir_.file("rb.exr"), {"R", "B"});
+  try {
+    (void)read_exr(dir_.file("rb.exr"), w, h);
+    ADD_FAILURE() << "read an EXR without G";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("G missing"), std::string::npos) << e.what();
+  }
+  write_channels(dir_.file("onevar.exr"), {"R", "G", "B", "variance.G"});
+  EXPECT_EQ(read_exr(dir_.file("onevar.exr"), w, h).size(), 12u);
+  EXPECT_THROW((void)read_exr_variance(dir_.file("onevar.exr")), InputError);
+  EXPECT_THROW((void)load_reference(dir_.file("onevar.exr")), InputError);
+  write_channels(dir_.file("whole.exr"), {"R", "G", "B"});
+  EXPECT_TRUE(read_exr_variance(dir_.file("whole.exr")).empty()) << "no variance layer at all is allowed";
 }
 
 TEST_F(FilmFileTest, ExrReaderRefusesWhatIsNotAnExr) {

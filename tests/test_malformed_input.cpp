@@ -8,10 +8,14 @@
 //
 // test_cli.cpp covers the first example of each class (unknown flag, missing
 // scene, syntax error, ...); this table adds the long tail.
+#include "renderer/film/film.h"
+#include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/scene/scene_loader.h"
 #include "tests/support.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -96,6 +100,14 @@ class MalformedInput : public ::testing::Test {
     fs::create_directory(gen("folder.json"));
     fs::create_directory(gen("folder.png"));
     write_bytes(gen("notes.txt"), "not a folder");
+    // Named pipes where a scene, a film or a reference is read: open() would
+    // wait for a writer forever (issue 33, item 10).
+    for (const char* fifo : {"fifo.json", "fifo.film", "fifo.pfm", "fifo.exr"})
+      ASSERT_EQ(::mkfifo(gen(fifo).c_str(), 0600), 0) << fifo;
+    // Films whose strategy text holds control bytes (an escape sequence, a
+    // newline): quoted in every message (issue 33, item 13).
+    write_film(gen("plain.film"), "cosine");
+    write_film(gen("escape.film"), "cos\x1b[31mine\nrm");
 
     // For bench: a valid 8x8 reference, and PFMs whose headers lie.
     const std::vector<float> rgb(8 * 8 * 3, 0.5f);
@@ -103,6 +115,22 @@ class MalformedInput : public ::testing::Test {
     write_bytes(gen("ref.pfm"), std::string(pfm.begin(), pfm.end()));
     write_bytes(gen("huge_header.pfm"), "PF\n16384 16384\n-1.0\n" + std::string(64, '\0'));
     write_bytes(gen("short_data.pfm"), "PF\n8 8\n-1.0\n" + std::string(100, '\0'));
+  }
+
+  // A valid 8x8 film of the book's box, one sample a pixel, whose header
+  // names `strategy`.
+  static void write_film(const std::string& path, const std::string& strategy) {
+    const Scene scene = load_scene_file(kBookScene);
+    FilmInfo info;
+    info.scene_hash = film_scene_hash(scene);
+    info.scene_file = kBookScene;
+    info.width = info.height = 8;
+    info.max_depth = scene.max_depth;
+    info.strategy = strategy;
+    info.ranges = {SampleRange{1, 0, 1}};
+    Film film(8, 8);
+    for (std::size_t p = 0; p < film.pixel_count(); ++p) film.add(p, Vec3(0.5f));
+    write_film_file(path, info, film);
   }
 
   std::vector<std::string> render(std::vector<std::string> extra = {}) const {
@@ -186,6 +214,8 @@ const std::map<std::string, std::string> kSceneFileNeedles = {
     {"degenerate_box.json", "objects[1]: box 'max' must exceed 'min' on every axis"},
     {"degenerate_quad_parallel.json", "objects[0]: degenerate quad: u and v are parallel"},
     {"degenerate_quad_zero_edge.json", "objects[0]: degenerate quad: u is zero"},
+    {"duplicate_nested_key.json", "objects[1].radius: the key appears twice"},
+    {"duplicate_objects.json", "objects: the key appears twice"},
     {"dielectric_ior_zero.json", "materials.white.ior: must be > 0"},
     {"empty.json", "empty.json: the scene is empty"},
     {"empty_objects.json", "objects: the scene has no objects"},
@@ -263,6 +293,7 @@ TEST_F(MalformedInput, AllAreRefusedCleanly) {
       {"newline_in_key.json", "unknown key 'li\\x0Aghts'"},
       {"latin1_key.json", "ill-formed UTF-8 byte; last read: '\"cam\\xE9r'"},
       {"folder.json", "it is a folder"},
+      {"fifo.json", "cannot read scene"},
   };
   for (const auto& [name, needle] : generated)
     cases.push_back({"scene " + name, with(render(), "--scene", gen(name).c_str()), needle});
@@ -304,6 +335,15 @@ TEST_F(MalformedInput, AllAreRefusedCleanly) {
       {render({"--stats-json", "image.png"}), "is named twice"},
       {render({"--stats-json", "./image.png"}), "is named twice"},
       {render({"stray"}), "stray"},
+      {with(render(), "--strategy", "mix:cosine=1.2e-10,light=1"), "below 2^-32"},
+      {render({"--reference", gen("fifo.pfm")}), "it is a pipe (FIFO)"},
+      {render({"--reference", gen("fifo.exr")}), "it is a pipe (FIFO)"},
+      {render({"--reference", gen("fifo.film")}), "it is a pipe (FIFO)"},
+      {{"render", "--resume", gen("fifo.film"), "--spp", "2", "--quiet"}, "cannot read film"},
+      {{"merge", gen("fifo.film"), "--out", "m.exr"}, "it is a pipe (FIFO)"},
+      {{"merge", gen("plain.film"), gen("fifo.film"), "--out", "m.exr"}, "it is a pipe (FIFO)"},
+      {{"render", "--resume", gen("escape.film"), "--spp", "2", "--quiet"}, "cos\\x1B[31mine\\x0Arm"},
+      {{"merge", gen("plain.film"), gen("escape.film"), "--out", "m.exr"}, "cos\\x1B[31mine\\x0Arm"},
       {{"rendr", "--scene", kBookScene}, "rendr"},
       {{"render"}, "--scene"},
       {{"--bogus"}, "--bogus"},
@@ -327,6 +367,7 @@ TEST_F(MalformedInput, AllAreRefusedCleanly) {
       {with(bench(), "--reference", kBookScene.c_str()), "is not a colour PFM image"},
       {with(bench(), "--reference", gen("nothing.pfm").c_str()), "cannot read"},
       {with(bench(), "--reference", gen("folder.json").c_str()), "folder.json"},
+      {with(bench(), "--reference", gen("fifo.pfm").c_str()), "it is a pipe (FIFO)"},
       {bench({"--plot", "out.csv"}), "is named twice"},
       {with(bench(), "--csv", (gen("notes.txt") + "/out.csv").c_str()), "does not exist"},
   };

@@ -4,6 +4,7 @@
 // scene's content; then `pdflab reference`, `render --reference auto` and
 // `bench --reference auto` on the real binary.
 #include "renderer/error.h"
+#include "renderer/film/exr_io.h"
 #include "renderer/film/film.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/metrics/reference.h"
@@ -321,6 +322,29 @@ TEST(SeedTrap, SameSeedIsNamedAndOthersPass) {
   EXPECT_FALSE(pdflab::is_reference_seed(1u << 30));
 }
 
+// Issue 33, item 5: every seed a reference's samples came from is known,
+// also for a merge of several ranges of one seed or of several seeds, and
+// for an EXR written before pdflab.seeds (its pdflab.samples is read).
+TEST(SeedTrap, EverySeedOfAMergeIsKnown) {
+  pdflab::ReferenceInfo info;
+  pdflab::set_seeds(info, {9, 3, 9});
+  EXPECT_TRUE(info.seed_known);
+  EXPECT_EQ(info.seeds, (std::vector<std::uint64_t>{3, 9}));
+  const pdflab::Strategy cosine = pdflab::Strategy::single(pdflab::Technique::Cosine);
+  EXPECT_FALSE(pdflab::shared_random_numbers(info, 9, cosine).empty());
+  EXPECT_FALSE(pdflab::shared_random_numbers(info, 3, cosine).empty());
+  EXPECT_TRUE(pdflab::shared_random_numbers(info, 4, cosine).empty());
+
+  pdflab::testing::TempDir dir("pdflab-seeds");
+  const std::vector<float> rgb(4 * 3, 0.5f);
+  pdflab::write_exr(dir.file("old.exr"), rgb, 2, 2,
+                    {{"pdflab.strategy", "cosine"}, {"pdflab.samples", "seed 4 samples [0, 8), seed 4 samples [16, 24)"}});
+  const pdflab::Reference old = pdflab::load_reference(dir.file("old.exr"));
+  EXPECT_EQ(old.info.seeds, (std::vector<std::uint64_t>{4}));
+  pdflab::write_exr(dir.file("new.exr"), rgb, 2, 2, {{"pdflab.strategy", "cosine"}, {"pdflab.seeds", "2,7"}});
+  EXPECT_EQ(pdflab::load_reference(dir.file("new.exr")).info.seeds, (std::vector<std::uint64_t>{2, 7}));
+}
+
 TEST(EstimateHistory, FlagsAnEstimateThatStopsFalling) {
   pdflab::EstimateHistory steady;
   for (std::uint32_t n = 2; n <= 4096; n *= 2) steady.add(n, 0.5 / n * (n % 3 == 0 ? 1.2 : 1.0));
@@ -489,6 +513,91 @@ TEST_F(ReferenceCommand, SameSeedAsTheReferenceIsRefused) {
                                 "--out", in_work("t.pfm")});
   EXPECT_EQ(trap.status, 2) << trap.err;
   EXPECT_NE(trap.err.find("and strategy cosine"), std::string::npos) << trap.err;
+}
+
+// Issue 33, item 5: the recipe of docs/measuring.md (render --out ref.pfm
+// with the default seed, then measure a render of the default seed against
+// it) was not caught without a sidecar and gave relMSE 0 +- 0. Every render
+// now writes what identifies it: a PFM's sidecar, an EXR's attributes, a
+// film's ranges, also for merges of several ranges of one seed or of several
+// seeds. A PFM that still lacks its sidecar gets a note.
+TEST_F(ReferenceCommand, TheSeedTrapClosesForBareFilesAndMerges) {
+  const std::vector<std::string> base = {"render", "--scene", kBookScene, "--strategy", "cosine", "--width", "16",
+                                         "--height", "12", "--threads", "2", "--quiet"};
+  const auto render = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return run(a);
+  };
+  ASSERT_EQ(render({"--spp", "64", "--out", in_work("ref.pfm")}).status, 0);
+  ASSERT_TRUE(fs::exists(in_work("ref.json")));
+  ChildResult r = render({"--spp", "8", "--reference", in_work("ref.pfm"), "--out", in_work("r.pfm")});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("seed 1 and strategy cosine"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(in_work("r.pfm")));
+
+  // Several ranges of one seed, and several seeds, as a film, an EXR and a PFM.
+  ASSERT_EQ(render({"--spp", "8", "--film-out", in_work("a.film")}).status, 0);
+  ASSERT_EQ(render({"--spp", "8", "--first-sample", "32", "--film-out", in_work("b.film")}).status, 0);
+  ASSERT_EQ(render({"--spp", "8", "--seed", "3", "--film-out", in_work("c.film")}).status, 0);
+  ASSERT_EQ(run({"merge", in_work("a.film"), in_work("b.film"), "--film-out", in_work("ranges.film"), "--out",
+                 in_work("ranges.exr")}).status, 0);
+  ASSERT_EQ(run({"merge", in_work("a.film"), in_work("b.film"), in_work("c.film"), "--out", in_work("seeds.pfm")}).status, 0);
+  for (const char* reference : {"ranges.film", "ranges.exr", "seeds.pfm"})
+    for (const char* seed : {"1", "3"}) {
+      if (std::string(reference) != "seeds.pfm" && std::string(seed) == "3") continue;
+      r = render({"--spp", "8", "--seed", seed, "--reference", in_work(reference), "--out", in_work("r.pfm")});
+      EXPECT_EQ(r.status, 2) << reference << " seed " << seed << ": " << r.err;
+      EXPECT_NE(r.err.find("share random numbers"), std::string::npos) << r.err;
+    }
+  r = render({"--spp", "8", "--seed", "2", "--reference", in_work("seeds.pfm"), "--out", in_work("r.pfm")});
+  EXPECT_EQ(r.status, 0) << r.err;
+
+  // A PFM without its sidecar: a note (with the render's seed), not silence.
+  fs::remove(in_work("ref.json"));
+  std::vector<std::string> loud = base;
+  loud.pop_back();  // not --quiet
+  loud.insert(loud.end(), {"--spp", "8", "--reference", in_work("ref.pfm"), "--out", in_work("r.pfm")});
+  r = run(loud);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("does not record its seed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("seed 1"), std::string::npos) << r.err;
+}
+
+// Issue 33, item 6: --reference auto that finds nothing (or a damaged entry)
+// says so with --quiet too, and the stats JSON records why.
+TEST_F(ReferenceCommand, QuietAutoReferenceThatFindsNothingSaysSo) {
+  const ChildResult r = render_auto(kBookScene, {"--quiet", "--stats-json", in_work("s.json")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --reference auto: no cached reference"), std::string::npos) << r.err;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(in_work("s.json")));
+  EXPECT_NE(stats.at("reference_missing").get<std::string>().find("no cached reference"), std::string::npos);
+  ASSERT_EQ(make_reference(kBookScene).status, 0);
+  for (const auto& e : fs::directory_iterator(cache()))
+    if (e.path().extension() == ".json") write_text(e.path(), "{");
+  const ChildResult damaged = render_auto(kBookScene, {"--quiet"});
+  ASSERT_EQ(damaged.status, 0) << damaged.err;
+  EXPECT_NE(damaged.err.find("warning: --reference auto: cached reference"), std::string::npos) << damaged.err;
+  EXPECT_NE(damaged.err.find("damaged"), std::string::npos) << damaged.err;
+}
+
+// Issue 33, item 9: a cache folder that is a file, a symlink loop or under a
+// file is refused before the render (it rendered the whole --seconds first),
+// and nothing is written, not even --out.
+TEST_F(ReferenceCommand, ACacheFolderThatCannotBeMadeIsRefusedBeforeRendering) {
+  // Beside the working folder, whose listing cannot follow a loop.
+  const std::string file = in_work("../file"), loop = in_work("../loop");
+  write_text(file, "not a folder");
+  fs::create_symlink(loop, loop);
+  for (const std::string& dir : {file, file + "/sub", loop, loop + "/sub"}) {
+    const std::vector<std::string> before = pdflab::testing::listing(work());
+    const ChildResult r = run({"reference", "--scene", kBookScene, "--width", "8", "--height", "8", "--seconds", "30",
+                               "--quiet", "--cache-dir", dir, "--out", in_work("ref.pfm")});
+    EXPECT_EQ(r.status, 2) << dir << ": " << r.err;
+    EXPECT_NE(r.err.find("reference cache folder"), std::string::npos) << r.err;
+    EXPECT_LT(r.cpu_seconds, 10.0) << "rendered before refusing " << dir;
+    EXPECT_EQ(pdflab::testing::listing(work()), before) << dir;
+  }
 }
 
 TEST_F(ReferenceCommand, BiasedStrategyWithoutReferenceShowsNoEfficiency) {

@@ -396,6 +396,43 @@ TEST(StrategyParse, ToStringRoundTrips) {
   EXPECT_EQ(Strategy::parse("mix:cosine=1,light=3").to_string(), "mix:cosine=0.25,light=0.75");
 }
 
+// Issue 33, item 12: a strategy's text (a film's header, a sidecar) parses
+// back to the very estimator: its parameters to the bit (shortest exact
+// decimals, not six digits: cosine-power:3.1415926 came back as 3.14159) and
+// its weights in exactly the same proportions, so the sampler's choice is the
+// same bits (1:2 came back as 0.333333:0.666667). Weights are printed as
+// shares where their total is a power of two (dividing is exact), else as
+// given.
+TEST(StrategyParse, ToStringRoundTripsToTheSameEstimator) {
+  const Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  const auto same_plan = [&](const Strategy& a, const Strategy& b, const std::string& text) {
+    const SamplingPlan pa = SamplingPlan::make(a, scene), pb = SamplingPlan::make(b, scene);
+    EXPECT_EQ(pa.choice_threshold, pb.choice_threshold) << text;
+    EXPECT_EQ(pa.weight, pb.weight) << text;
+    EXPECT_EQ(pa.parameter, pb.parameter) << text;
+  };
+  for (const char* text :
+       {"cosine-power:3.1415926", "cosine-power:0.1", "mix:cosine=1,light=2", "mix:cosine=0.1,light=0.7",
+        "mix:cosine=3,light=7,uniform-sphere=11", "mix:cosine=0.3,light=0.7", "nee-mis+mix:cosine=1,light=2+rr:7",
+        "mix:cosine-power:2.71828182=1,light=1e-9", "mix:cosine=1e-30,light=1", "mix:cosine=2e38,light=3e38",
+        "mix:cosine=1,light=3", "fastest"}) {
+    const Strategy s = Strategy::parse(text);
+    const std::string once = s.to_string();
+    Strategy back;
+    ASSERT_NO_THROW(back = Strategy::parse(once)) << text << " -> '" << once << "'";
+    EXPECT_EQ(back.to_string(), once) << text;
+    EXPECT_EQ(back.parameters, s.parameters) << text << " -> " << once;
+    if (std::string(text).find("e-30") == std::string::npos && std::string(text).find("e38") == std::string::npos)
+      same_plan(s, back, std::string(text) + " -> " + once);  // (those two cannot be sampled: below 2^-32, or no light)
+  }
+  EXPECT_EQ(Strategy::parse("cosine-power:3.1415926").to_string(), "cosine-power:3.1415925");  // the float's shortest
+  EXPECT_EQ(Strategy::parse("mix:cosine=1,light=2").to_string(), "mix:cosine=1,light=2");
+  EXPECT_EQ(Strategy::parse("mix:cosine=2,light=2").to_string(), "mix:cosine=0.5,light=0.5");
+  EXPECT_EQ(Strategy::parse("mix:cosine=0.3,light=0.7").to_string(), "mix:cosine=0.3,light=0.7");
+  EXPECT_EQ(Strategy::parse("mix:cosine=2e38,light=3e38").to_string(), "mix:cosine=2e38,light=3e38")
+      << "no '+' in an exponent: it would split the strategy";
+}
+
 // ---- SamplingPlan -------------------------------------------------------------------------
 
 // A shading point at the origin (normal +y) and one small importance target: a
@@ -491,8 +528,11 @@ TEST(SamplingPlan, TinyWeightsAreRealisedExactlyOrRefused) {
   // The mixture's pdf for a cosine direction carries exactly that weight.
   const Vec3 origin(0.0f), normal(0, 1, 0), away = normalize(Vec3(1, 0.2f, 0));  // misses the light
   EXPECT_FLOAT_EQ(plan.pdf(origin, normal, away), plan.weight[cosine] * cosine_hemisphere_pdf(normal, away));
-  // Below 2^-32 the sampler has no share to give: refused, naming the technique.
-  for (const char* text : {"mix:cosine=1e-45,light=1", "mix:light=1,uniform-hemisphere=1e-11"}) {
+  // Below 2^-32 the sampler has no share to give: refused, naming the technique
+  // (issue 33, item 13: also between 2^-33 and 2^-32, which rounded up to
+  // one count and so was realised up to twice as large as asked).
+  for (const char* text : {"mix:cosine=1e-45,light=1", "mix:light=1,uniform-hemisphere=1e-11",
+                           "mix:cosine=1.2e-10,light=1", "mix:cosine=2.2e-10,light=1"}) {
     try {
       (void)SamplingPlan::make(Strategy::parse(text), scene);
       ADD_FAILURE() << text << " was accepted";
@@ -508,6 +548,17 @@ TEST(SamplingPlan, TinyWeightsAreRealisedExactlyOrRefused) {
 // A light a billion times dimmer than another is still chosen, as often as
 // its power says, whether it is listed first or last (a float CDF never
 // chose it when it came after the bright one).
+TEST(SamplingPlan, TheSmallestShareIsTwoToTheMinus32) {
+  const Scene scene = one_target_scene(false);
+  constexpr int cosine = static_cast<int>(Technique::Cosine);
+  // Just above 2^-32 of the total (light 2^32 - 256): one count; just below
+  // (light 2^32: 1 / (2^32 + 1), which rounds to one count too): refused.
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=1,light=4294967040"), scene);
+  EXPECT_EQ(plan.choice_threshold[cosine], 1u);
+  EXPECT_THROW((void)SamplingPlan::make(Strategy::parse("mix:cosine=1,light=4294967296"), scene), InputError)
+      << "a share a hair below 2^-32";
+}
+
 TEST(SamplingPlan, PowerRatiosOfABillionAreRealisedInEitherOrder) {
   for (const bool dim_first : {true, false}) {
     Scene scene;

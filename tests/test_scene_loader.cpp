@@ -433,6 +433,72 @@ TEST(SceneValidation, UpVectorParallelToView) {
   expect_error_mentions(doc, {"camera", "lookfrom"});
 }
 
+// Issue 33, item 13: a camera far from its target squares its distance past
+// float's range; it is looking along +z, not along vup, and is loaded with a
+// finite camera (the check and the camera's basis normalise by the largest
+// component first). A vup that is tiny, or huge, is a direction too.
+TEST(SceneValidation, AFarCameraIsNotCalledParallelToVup) {
+  for (const double far : {1.8e19, 1e25, 1e30}) {
+    json doc = minimal_scene();
+    doc["camera"]["lookfrom"] = json::array({0, 0, -far});
+    Scene scene;
+    ASSERT_NO_THROW(scene = load_scene_text(doc.dump(), "scene.json")) << far;
+    const Camera& c = scene.camera;
+    for (const Vec3& v : {c.pixel00, c.du, c.dv})
+      EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z)) << far;
+    EXPECT_GT(c.pixel00.z, 0.0f) << "a camera at -z looks along +z: " << far;
+  }
+  for (const double up : {1e-30, 1e30}) {
+    json doc = minimal_scene();
+    doc["camera"]["vup"] = json::array({0, up, 0});
+    EXPECT_NO_THROW((void)load_scene_text(doc.dump(), "scene.json")) << up;
+  }
+  // Still refused when it is parallel, near or far.
+  json doc = minimal_scene();
+  doc["camera"]["lookfrom"] = json::array({0, 0, -1e25});
+  doc["camera"]["vup"] = json::array({0, 0, 1e-30});
+  expect_error_mentions(doc, {"camera", "vup is zero or parallel"});
+  // The bits of an ordinary camera are normalize()'s, as before.
+  EXPECT_EQ(unit_direction(Vec3(0.3f, -2.0f, 5.0f)), normalize(Vec3(0.3f, -2.0f, 5.0f)));
+}
+
+// Issue 33, item 13: JSON lets a key appear twice and the parser kept the last
+// value: two "objects" arrays lost the first without a word. Refused, with
+// the key's path, at any depth.
+TEST(SceneValidation, DuplicateKeysAreRefusedWithTheirPath) {
+  const std::string objects = R"([{ "type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white" },
+      { "type": "quad", "q": [-1, 3, -1], "u": [2, 0, 0], "v": [0, 0, 2], "material": "lamp" }])";
+  const std::string head = R"({"camera": { "width": 8, "height": 6, "vfov": 40, "lookfrom": [0, 0, -10], "lookat": [0, 0, 0] },
+    "materials": { "white": { "type": "lambertian", "albedo": [0.5, 0.5, 0.5] },
+                   "lamp": { "type": "diffuse_light", "emit": [4, 4, 4] } },)";
+  EXPECT_NO_THROW((void)load_scene_text(head + R"("objects": )" + objects + "}", "scene.json"));
+  const struct {
+    std::string text, needle;
+  } cases[] = {
+      {head + R"("objects": )" + objects + R"(, "objects": [])", "scene.json: objects: the key appears twice"},
+      {R"({"camera": { "width": 8, "height": 6, "vfov": 40, "vfov": 50, "lookfrom": [0, 0, -10], "lookat": [0, 0, 0] }})",
+       "scene.json: camera.vfov: the key appears twice"},
+      {R"({"materials": { "white": { "type": "lambertian", "albedo": [1, 1, 1], "albedo": [0, 0, 0] } }})",
+       "scene.json: materials.white.albedo: the key appears twice"},
+      {R"({"objects": [ {"type": "sphere"}, {"type": "sphere", "radius": 1, "radius": 2} ]})",
+       "scene.json: objects[1].radius: the key appears twice"},
+      {R"({"a": [[1, 2], {"b": {"c": 1, "c": 2}}]})", "scene.json: a[1].b.c: the key appears twice"},
+  };
+  for (const auto& c : cases) {
+    const std::string message = load_error(c.text + (c.text.back() == '}' ? "" : "}"));
+    EXPECT_NE(message.find(c.needle), std::string::npos) << message;
+  }
+}
+
+// Issue 33, item 13: a NUL in a key no longer cuts the message short (it was
+// a C string once made into the exception); it shows as \x00 with the rest.
+TEST(SceneValidation, ANulInAKeyIsShownNotCut) {
+  const std::string message = load_error(R"({"cam\u0000era": 1, "camera": {}})");
+  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, materials, name, objects)"),
+            std::string::npos)
+      << message;
+}
+
 TEST(SceneValidation, BoxExtentsAndMaterialRanges) {
   json doc = minimal_scene();
   doc["objects"][0] = json::parse(R"({"type": "box", "min": [0,0,0], "max": [1,0,1], "material": "white"})");

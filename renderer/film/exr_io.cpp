@@ -2,6 +2,7 @@
 
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
+#include "renderer/input_file.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -60,11 +61,14 @@ void write_exr(const std::string& path, const Film& film, const ImageAttributes&
   const int w = film.width(), h = film.height();
   Imf::Header header = make_header(w, h, attributes);
   for (const char* c : kVarianceChannels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-  header.channels().insert(kCountChannel, Imf::Channel(Imf::UINT));
+  // FLOAT, not UINT: image tools (OpenImageIO's oiiotool, and what is built on
+  // it) read an unsigned channel as a fraction of 2^32 (8 samples as 1.9e-9);
+  // a float holds every count up to 2^24 = 16,777,216 samples exactly.
+  header.channels().insert(kCountChannel, Imf::Channel(Imf::FLOAT));
 
   const std::size_t strip_pixels = static_cast<std::size_t>(w) * kRowsPerStrip;
   std::vector<float> mean(3 * strip_pixels), variance(3 * strip_pixels);
-  std::vector<std::uint32_t> count(strip_pixels);
+  std::vector<float> count(strip_pixels);
   const auto fill = [&](int y0, int rows) {
     const std::size_t first = static_cast<std::size_t>(y0) * static_cast<std::size_t>(w);
     for (std::size_t i = 0; i < static_cast<std::size_t>(rows) * static_cast<std::size_t>(w); ++i) {
@@ -74,7 +78,7 @@ void write_exr(const std::string& path, const Film& film, const ImageAttributes&
         mean[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(m[c]);
         variance[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(v[c]);
       }
-      count[i] = film.count(first + i);
+      count[i] = static_cast<float>(film.count(first + i));
     }
   };
   const auto frame = [&](int y0, int rows) {
@@ -83,7 +87,7 @@ void write_exr(const std::string& path, const Film& film, const ImageAttributes&
       fb.insert(kMeanChannels[c], strip_slice(Imf::FLOAT, mean.data() + c, y0, w, rows, 3 * sizeof(float)));
       fb.insert(kVarianceChannels[c], strip_slice(Imf::FLOAT, variance.data() + c, y0, w, rows, 3 * sizeof(float)));
     }
-    fb.insert(kCountChannel, strip_slice(Imf::UINT, count.data(), y0, w, rows, sizeof(std::uint32_t)));
+    fb.insert(kCountChannel, strip_slice(Imf::FLOAT, count.data(), y0, w, rows, sizeof(float)));
     return fb;
   };
   write_strips(path, header, h, frame, fill);
@@ -107,6 +111,7 @@ namespace {
 // Three float channels of an EXR as interleaved RGB; empty when the file has
 // none of them.
 std::vector<float> read_exr_channels(const std::string& path, const char* const (&names)[3], int& width, int& height) {
+  check_input_file(path, "EXR");  // OpenEXR opens by name: a pipe would hold it
   try {
     Imf::InputFile in(path.c_str(), 1);
     const IMATH_NAMESPACE::Box2i dw = in.header().dataWindow();
@@ -114,9 +119,18 @@ std::vector<float> read_exr_channels(const std::string& path, const char* const 
     const long long h = static_cast<long long>(dw.max.y) - dw.min.y + 1;
     if (const std::string problem = image_size_problem(w, h); !problem.empty())
       throw InputError("'" + path + "': " + problem);
-    bool any = false;
-    for (const char* c : names) any = any || in.header().channels().findChannel(c) != nullptr;
-    if (!any) return {};
+    std::string missing;
+    int found = 0;
+    for (const char* c : names) {
+      if (in.header().channels().findChannel(c)) ++found;
+      else missing += (missing.empty() ? "" : ", ") + std::string(c);
+    }
+    if (found == 0) return {};
+    // Part of a layer is a damaged or foreign file: a missing channel would
+    // read as 0 (a green-less reference, a variance of nothing).
+    if (found < 3)
+      throw InputError("EXR '" + path + "' has " + std::to_string(found) + " of the channels " + names[0] + ", " +
+                       names[1] + ", " + names[2] + ": " + missing + " missing");
     std::vector<float> rgb(3 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0.0f);
     Imf::FrameBuffer fb;
     for (int c = 0; c < 3; ++c)
@@ -148,6 +162,7 @@ std::vector<float> read_exr_variance(const std::string& path) {
 }
 
 std::string read_exr_attribute(const std::string& path, const std::string& name) {
+  check_input_file(path, "EXR");
   try {
     Imf::InputFile in(path.c_str(), 1);
     const auto* a = in.header().findTypedAttribute<Imf::StringAttribute>(name);

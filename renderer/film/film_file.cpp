@@ -2,6 +2,7 @@
 
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
+#include "renderer/input_file.h"
 #include "renderer/scene/scene.h"
 
 #include <zlib.h>
@@ -159,8 +160,24 @@ std::vector<std::pair<std::string, std::string>> film_image_attributes(const Fil
                                                         {"pdflab.samples", info.ranges_text()},
                                                         {"pdflab.maxDepth", std::to_string(info.max_depth)},
                                                         {"pdflab.version", version}};
-  if (info.ranges.size() == 1) a.emplace_back("pdflab.seed", std::to_string(info.ranges.front().seed));
+  // The seeds: a reference made from this image knows which random numbers
+  // to avoid, also when it is a merge of several ranges or seeds.
+  const std::vector<std::uint64_t> seeds = info.seeds();
+  std::string list;
+  for (std::uint64_t seed : seeds) {
+    if (!list.empty()) list += ',';
+    list += std::to_string(seed);
+  }
+  a.emplace_back("pdflab.seeds", list);
+  if (seeds.size() == 1) a.emplace_back("pdflab.seed", list);
   return a;
+}
+
+std::vector<std::uint64_t> FilmInfo::seeds() const {
+  std::vector<std::uint64_t> out;
+  for (const SampleRange& r : ranges)
+    if (std::find(out.begin(), out.end(), r.seed) == out.end()) out.push_back(r.seed);
+  return out;
 }
 
 std::uint64_t FilmInfo::spp() const {
@@ -194,7 +211,8 @@ void write_film_file(const std::string& path, const FilmInfo& info, const Film& 
   file.write(header.data(), header.size());
   file.write(&state, 4);
 
-  state = 0;
+  // The data's CRC runs on from the header's: it covers the whole file, so a
+  // header copied onto another film's data fails it.
   const auto put = [&](const auto& v) {
     const std::size_t bytes = v.size() * sizeof(v[0]);
     state = crc(state, v.data(), bytes);
@@ -219,8 +237,8 @@ FilmFile read_film_stream(std::FILE* f, std::uint64_t size, const std::string& n
   std::uint32_t version = 0, header_size = 0;
   std::memcpy(&version, preamble + 8, 4);
   std::memcpy(&header_size, preamble + 12, 4);
-  if (version != kFilmFormatVersion)
-    top.bad("film format version " + std::to_string(version) + "; this pdflab reads version " +
+  if (version != kFilmFormatVersion && version != 1)
+    top.bad("film format version " + std::to_string(version) + "; this pdflab reads versions 1 and " +
             std::to_string(kFilmFormatVersion));
   if (header_size > kMaxHeaderBytes || kPreambleBytes + header_size + 4 > size)
     top.bad("the header ends after the end of the file (truncated or corrupt)");
@@ -273,7 +291,8 @@ FilmFile read_film_stream(std::FILE* f, std::uint64_t size, const std::string& n
   // The size is now backed by the file itself: allocating is safe.
   Film& film = out.film;
   film.reset(info.width, info.height);
-  std::uint32_t state = 0;
+  // Version 1 checksummed the data alone; version 2 runs on from the header's.
+  std::uint32_t state = version == 1 ? 0 : stored_crc;
   read_array(f, film.sums(), state, h);
   read_array(f, film.squares(), state, h);
   read_array(f, film.counts(), state, h);
@@ -295,15 +314,10 @@ FilmFile read_film_stream(std::FILE* f, std::uint64_t size, const std::string& n
 }
 
 FilmFile read_film_file(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw InputError("cannot read film '" + path + "': " + std::strerror(errno));
-  struct stat st{};
-  if (::fstat(::fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-    std::fclose(f);
-    throw InputError("film '" + path + "' is not a regular file");
-  }
+  std::uint64_t size = 0;
+  std::FILE* f = open_input_file(path, "film", InputKind::RegularFile, &size);  // never waits on a pipe
   try {
-    FilmFile out = read_film_stream(f, static_cast<std::uint64_t>(st.st_size), path);
+    FilmFile out = read_film_stream(f, size, path);
     std::fclose(f);
     return out;
   } catch (...) {

@@ -14,7 +14,9 @@
 
 namespace pdflab {
 
-inline constexpr std::uint32_t kFilmFormatVersion = 1;
+// Version 2: the data's checksum continues the header's, so a header cannot be
+// put on another film's data unnoticed. Version 1 files are still read.
+inline constexpr std::uint32_t kFilmFormatVersion = 2;
 
 // Samples first .. end - 1 of the sequence of `seed`, in every pixel.
 struct SampleRange {
@@ -39,6 +41,8 @@ struct FilmInfo {
   std::uint64_t spp() const;
   // "seed 1 samples [0, 64)", ranges separated by ", ".
   std::string ranges_text() const;
+  // Every seed of its ranges, once each, in order.
+  std::vector<std::uint64_t> seeds() const;
 };
 
 struct Scene;

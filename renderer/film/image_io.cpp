@@ -3,6 +3,7 @@
 #include "renderer/error.h"
 #include "renderer/film/exr_io.h"
 #include "renderer/film/film.h"
+#include "renderer/input_file.h"
 
 #include <stb_image_write.h>
 #include <fcntl.h>
@@ -244,6 +245,7 @@ std::vector<float> read_image_linear(const std::string& path, int& width, int& h
 }
 
 std::vector<float> read_pfm(const std::string& path, int& width, int& height) {
+  check_input_file(path, "image");  // a folder, a pipe or a device is refused before it is opened as a stream
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot read '" + path + "': " + std::strerror(errno));
   std::string magic;

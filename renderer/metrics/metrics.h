@@ -63,6 +63,8 @@ class EstimateHistory {
   bool unreliable() const { return unreliable_; }
   // estimate * spp now over the same at half the samples or fewer (0 before then).
   double growth() const { return growth_; }
+  // The points kept: (spp, estimate * spp), at least 2% apart in spp.
+  const std::vector<std::pair<std::uint32_t, double>>& points() const { return points_; }
 
  private:
   std::vector<std::pair<std::uint32_t, double>> points_;  // spp, estimate * spp

@@ -6,6 +6,7 @@
 #include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
 #include "renderer/hash.h"
+#include "renderer/input_file.h"
 #include "renderer/metrics/metrics.h"
 #include "renderer/scene/scene.h"
 
@@ -19,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 namespace pdflab {
 
@@ -30,14 +32,13 @@ namespace {
 constexpr const char* kFormat = "pdflab-reference";
 constexpr int kFormatVersion = 1;
 
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+// A sidecar or an image whose checksum is taken: a regular file, never a pipe.
+std::string read_bytes(const std::string& path, const char* what) {
+  return read_input_file(path, what, std::numeric_limits<std::size_t>::max());
 }
 
 std::string file_checksum(const std::string& path) {
-  const std::string bytes = read_bytes(path);
+  const std::string bytes = read_bytes(path, "file");
   return fnv1a_hex(bytes.data(), bytes.size());
 }
 
@@ -63,7 +64,7 @@ T field(const json& j, const char* key, T fallback) {
 
 json parse_json(const std::string& path) {
   try {
-    json j = json::parse(read_bytes(path));
+    json j = json::parse(read_bytes(path, "sidecar"));
     if (j.is_object()) return j;
   } catch (const json::exception&) {
     throw InputError("sidecar '" + path + "' is not valid JSON (truncated or damaged)");
@@ -81,11 +82,15 @@ ReferenceInfo parse_sidecar(const std::string& path, const json& j) {
     info.scene_hash = field<std::string>(j, "scene_hash", "");
     info.max_depth = field<int>(j, "max_depth", 0);
     info.strategy = field<std::string>(j, "strategy", "");
-    if (j.contains("seed") && j["seed"].is_number_unsigned()) {
-      info.seed_known = true;
-      info.seed = j["seed"].get<std::uint64_t>();
-      if (is_reference_seed(info.seed)) info.seed_stream = static_cast<std::uint32_t>(info.seed - kReferenceSeedBase);
-    }
+    // "seeds" (a render's sidecar lists every seed of a merge), else "seed".
+    std::vector<std::uint64_t> seeds;
+    if (j.contains("seeds") && j["seeds"].is_array())
+      for (const json& seed : j["seeds"]) seeds.push_back(seed.get<std::uint64_t>());
+    else if (j.contains("seed") && j["seed"].is_number_unsigned())
+      seeds.push_back(j["seed"].get<std::uint64_t>());
+    set_seeds(info, seeds);
+    if (info.seed_known && is_reference_seed(info.seed))
+      info.seed_stream = static_cast<std::uint32_t>(info.seed - kReferenceSeedBase);
     info.spp = field<std::uint32_t>(j, "spp", 0);
     info.seconds = field<double>(j, "seconds", 0.0);
     info.estimated_relmse = field<double>(j, "estimated_relmse", 0.0);
@@ -186,8 +191,9 @@ Reference load_film_reference(const std::string& path) {
   info.scene_hash = hash;
   info.max_depth = f.max_depth;
   info.strategy = f.strategy;
-  info.seed_known = f.ranges.size() == 1;
-  if (info.seed_known) info.seed = f.ranges.front().seed;
+  std::vector<std::uint64_t> seeds;
+  for (const SampleRange& range : f.ranges) seeds.push_back(range.seed);
+  set_seeds(info, seeds);  // every seed of a merge, one or several
   info.spp = static_cast<std::uint32_t>(f.spp());
   info.seconds = f.seconds;
   Reference r = reference_from_film(file.film, std::move(info));
@@ -204,11 +210,25 @@ Reference load_exr_reference(const std::string& path) {
   r.variance = read_exr_variance(path);
   if (!r.variance.empty()) check_values(path, r.variance, r.width, true);
   r.info.strategy = read_exr_attribute(path, "pdflab.strategy");
-  const std::string seed = read_exr_attribute(path, "pdflab.seed");
-  if (!seed.empty()) {
-    r.info.seed_known = true;
-    r.info.seed = std::strtoull(seed.c_str(), nullptr, 10);
+  // pdflab.seeds lists every seed; an EXR written before it has pdflab.seed
+  // (one range) or only pdflab.samples ("seed 1 samples [0, 64), ...").
+  std::string seeds = read_exr_attribute(path, "pdflab.seeds");
+  if (seeds.empty()) seeds = read_exr_attribute(path, "pdflab.seed");
+  if (seeds.empty()) {
+    const std::string samples = read_exr_attribute(path, "pdflab.samples");
+    for (std::size_t at = samples.find("seed "); at != std::string::npos; at = samples.find("seed ", at + 5))
+      seeds += std::to_string(std::strtoull(samples.c_str() + at + 5, nullptr, 10)) + ",";
   }
+  std::vector<std::uint64_t> list;
+  for (std::size_t at = 0; at < seeds.size();) {
+    char* end = nullptr;
+    const std::uint64_t seed = std::strtoull(seeds.c_str() + at, &end, 10);
+    if (end == seeds.c_str() + at) break;
+    list.push_back(seed);
+    at = static_cast<std::size_t>(end - seeds.c_str());
+    if (at < seeds.size() && seeds[at] == ',') ++at;
+  }
+  set_seeds(r.info, list);
   r.info.spp = static_cast<std::uint32_t>(std::strtoul(read_exr_attribute(path, "pdflab.spp").c_str(), nullptr, 10));
   r.info.has_sidecar = !r.info.strategy.empty();
   return r;
@@ -253,8 +273,18 @@ Reference load_reference(const std::string& path) {
   return r;
 }
 
+void set_seeds(ReferenceInfo& info, std::vector<std::uint64_t> seeds) {
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  info.seed_known = !seeds.empty();
+  info.seed = seeds.empty() ? 0 : seeds.front();
+  info.seeds = std::move(seeds);
+}
+
 std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t seed, const Strategy& strategy) {
-  if (!reference.seed_known || reference.seed != seed) return {};
+  if (!reference.seed_known) return {};
+  const bool listed = std::find(reference.seeds.begin(), reference.seeds.end(), seed) != reference.seeds.end();
+  if (reference.seed != seed && !listed) return {};
   const bool same_strategy = reference.strategy == strategy.to_string();
   return "the reference was rendered with seed " + std::to_string(seed) + (same_strategy ? " and strategy " : "") +
          (same_strategy ? reference.strategy : std::string()) +

@@ -38,7 +38,10 @@ struct ReferenceInfo {
   int max_depth = 0;
   std::string strategy;  // canonical form; empty when unknown
   bool seed_known = false;
-  std::uint64_t seed = 0;
+  std::uint64_t seed = 0;  // the first of `seeds`
+  // Every seed its samples came from, when known: one for a render, several
+  // for a merge of seeds (film, EXR, sidecar).
+  std::vector<std::uint64_t> seeds;
   std::uint32_t seed_stream = 0;  // seed - kReferenceSeedBase for a reference seed
   std::uint32_t spp = 0;
   double seconds = 0.0;
@@ -92,9 +95,13 @@ void save_reference(const std::string& mean_path, const Reference& reference);
 // only when the sidecar does not claim one.
 Reference load_reference(const std::string& path);
 
+// Sets seed_known, seed and seeds from a list of seeds (duplicates dropped);
+// an empty list leaves the seed unknown.
+void set_seeds(ReferenceInfo& info, std::vector<std::uint64_t> seeds);
+
 // A render with `seed` compared against `reference` would share random
-// numbers with it (the same seed, whatever the strategy: pixel positions and
-// first bounces would repeat). Empty when not; otherwise a sentence saying so.
+// numbers with it (one of its seeds, whatever the strategy: pixel positions
+// and first bounces would repeat). Empty when not; otherwise a sentence saying so.
 std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t seed, const Strategy& strategy);
 
 // The strategy a reference is made with when none is given: the most efficient

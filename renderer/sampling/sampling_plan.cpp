@@ -49,10 +49,16 @@ std::array<double, kTechniqueCount> usable_weights(const Strategy& strategy, con
 // by 1e-9 (an image 45 times too bright); below 2^-32 there is no share to give.
 DiscreteDistribution technique_choice(const Strategy& strategy, const std::array<double, kTechniqueCount>& w) {
   DiscreteDistribution choice(w, DiscreteDistribution::Tiny::Zero);
-  if (!choice.zero_positive().empty()) {
-    const int i = choice.zero_positive().front();
-    double total = 0.0;
-    for (double x : w) total += x;
+  double total = 0.0;
+  for (double x : w) total += x;
+  // A share below 2^-32 that rounds up to one count (2^-33 and above) would
+  // be realised larger than asked: refused like one that rounds to none.
+  int tiny = choice.zero_positive().empty() ? -1 : choice.zero_positive().front();
+  for (int i = 0; i < kTechniqueCount && tiny < 0; ++i)
+    if (w[static_cast<std::size_t>(i)] > 0.0 && w[static_cast<std::size_t>(i)] / total < DiscreteDistribution::kResolution)
+      tiny = i;
+  if (tiny >= 0) {
+    const int i = tiny;
     char share[32];
     std::snprintf(share, sizeof share, "%.3g", w[i] / total);
     throw InputError("strategy '" + strategy.to_string() + "': " +

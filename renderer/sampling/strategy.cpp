@@ -6,6 +6,7 @@
 #include "renderer/sampling/sobol.h"
 
 #include <charconv>
+#include <cmath>
 #include <numbers>
 #include <cstdio>
 
@@ -35,10 +36,15 @@ std::string known_list() {
   return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +sobol, +rr or +rr:D)";
 }
 
+// The shortest decimal that reads back as the same float: a strategy's text
+// (a film's header, a sidecar) parses back to the very estimator it names.
 std::string format_number(float x) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(x));
-  return buf;
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);
+  std::string text = ec == std::errc() ? std::string(buf, end) : std::string("nan");
+  // 3e+38 as 3e38: '+' joins a strategy's parts, and from_chars reads both.
+  if (const std::size_t plus = text.find("e+"); plus != std::string::npos) text.erase(plus + 1, 1);
+  return text;
 }
 
 float parse_parameter(const TechniqueInfo& t, std::string_view text, std::string_view whole) {
@@ -321,6 +327,19 @@ std::string Strategy::mixture_string() const {
     if (weights[i] > 0.0f) ++used, last = i;
   double total = 0.0;  // in double: weights near FLT_MAX would overflow a float sum
   for (float w : weights) total += w;
+  // Shares (weights over their total) where the total is a power of two (1
+  // for cosine=0.5,light=0.5, 4 for cosine=1,light=3): dividing by it is exact,
+  // so the shares parse back to weights in exactly the same proportions and
+  // the sampler's choice (SamplingPlan, from w / total) is the same bits.
+  // Otherwise (cosine=1,light=2) the weights as given, which parse back to
+  // themselves; rounded shares (0.333333) would choose another estimator.
+  int exponent = 0;
+  const bool power_of_two = std::frexp(total, &exponent) == 0.5;
+  const double scale = power_of_two ? std::ldexp(1.0, 1 - exponent) : 1.0;
+  bool exact = true;  // every scaled weight a float (no underflow)
+  for (float w : weights)
+    exact = exact && static_cast<double>(static_cast<float>(w * scale)) == static_cast<double>(w) * scale;
+  const double divisor = exact ? 1.0 / scale : 1.0;
   // NAME, or NAME:PARAMETER for a technique with one.
   auto spelled = [&](int i) {
     std::string name(kTable[i].name);
@@ -332,10 +351,8 @@ std::string Strategy::mixture_string() const {
   bool first = true;
   for (int i = 0; i < kTechniqueCount; ++i) {
     if (weights[i] <= 0.0f) continue;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(weights[i]) / total);
     if (!first) out += ',';
-    out.append(spelled(i)).append("=").append(buf);
+    out.append(spelled(i)).append("=").append(format_number(static_cast<float>(weights[i] / divisor)));
     first = false;
   }
   return out;

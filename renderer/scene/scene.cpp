@@ -76,12 +76,20 @@ Quad make_quad(const Vec3& q, const Vec3& u, const Vec3& v, std::uint32_t materi
   return quad;
 }
 
+Vec3 unit_direction(const Vec3& a) {
+  const float squared = length_squared(a);
+  if (squared >= std::numeric_limits<float>::min() && squared <= std::numeric_limits<float>::max()) return normalize(a);
+  const float largest = max_abs_component(a);
+  if (!(largest > 0.0f) || !std::isfinite(largest)) return Vec3(0.0f);
+  return normalize(a / largest);
+}
+
 void Camera::prepare() {
   const float theta = vfov_degrees * (kPi / 180.0f);
   const float viewport_height = 2.0f * std::tan(theta * 0.5f);
   const float viewport_width = viewport_height * (static_cast<float>(width) / static_cast<float>(height));
-  const Vec3 w = normalize(lookfrom - lookat);
-  const Vec3 u = normalize(cross(vup, w));
+  const Vec3 w = unit_direction(lookfrom - lookat);
+  const Vec3 u = unit_direction(cross(vup, w));
   const Vec3 v = cross(w, u);
   du = u * (viewport_width / static_cast<float>(width));
   dv = -v * (viewport_height / static_cast<float>(height));

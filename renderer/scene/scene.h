@@ -56,6 +56,12 @@ struct Target {
   std::uint32_t index;  // into Scene::quads or Scene::spheres
 };
 
+// `a` over its length, also where the length's square leaves float's range
+// (a camera 1e19 from its target, a vup of 1e-30): then `a` is first divided
+// by its largest component. Elsewhere exactly normalize(a). A zero vector
+// gives zero.
+Vec3 unit_direction(const Vec3& a);
+
 struct Camera {
   int width = 600;
   int height = 600;

@@ -3,6 +3,7 @@
 #include "renderer/error.h"
 #include "renderer/film/film.h"
 #include "renderer/hash.h"
+#include "renderer/input_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -12,7 +13,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <functional>
 #include <set>
+#include <vector>
 
 namespace pdflab {
 
@@ -23,46 +26,6 @@ namespace {
 // A scene is a few kilobytes; this bounds what a wrong path (a disk image,
 // /dev/zero) can make the loader read into memory.
 constexpr std::size_t kMaxSceneBytes = std::size_t{64} << 20;
-
-// Messages go to a terminal: control bytes and invalid UTF-8 from a binary
-// file or a JSON string (unknown key "\n...") become \xNN, valid UTF-8 stays.
-std::string printable(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  const auto escape = [&](unsigned char c) {
-    char buf[8];
-    std::snprintf(buf, sizeof buf, "\\x%02X", c);
-    out += buf;
-  };
-  for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-      ++i;
-      continue;
-    }
-    // Length of a well-formed UTF-8 sequence starting here (0: none).
-    std::size_t n = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
-    if (n > 0 && i + n <= s.size()) {
-      for (std::size_t k = 1; k < n; ++k)
-        if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) n = 0;
-      // Overlong three- and four-byte forms, surrogates and code points past U+10FFFF.
-      const auto c1 = n > 0 ? static_cast<unsigned char>(s[i + 1]) : 0;
-      if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 >= 0xA0) || (c == 0xF0 && c1 < 0x90) || (c == 0xF4 && c1 >= 0x90))
-        n = 0;
-    } else {
-      n = 0;
-    }
-    if (n == 0) {
-      escape(c);
-      ++i;
-    } else {
-      out.append(s, i, n);
-      i += n;
-    }
-  }
-  return out;
-}
 
 // A JSON value with the path that leads to it, for error messages.
 class Node {
@@ -154,9 +117,12 @@ void parse_camera(const Node& node, Scene& scene) {
   cam.lookat = node.require("lookat").vec3();
   cam.vup = node.has("vup") ? node.child("vup").vec3() : Vec3(0.0f, 1.0f, 0.0f);
   const Vec3 view = cam.lookat - cam.lookfrom;
-  if (length_squared(view) == 0.0f) node.fail("lookfrom and lookat are the same point");
-  const Vec3 side = cross(cam.vup, normalize(view));
-  if (!(length(side) > 1e-6f * length(cam.vup))) node.fail("vup is zero or parallel to the viewing direction");
+  if (view == Vec3(0.0f)) node.fail("lookfrom and lookat are the same point");
+  // Both as unit vectors whatever their length (unit_direction): a camera far
+  // from its target squares its distance past float's range, and is not
+  // therefore looking along vup.
+  const Vec3 side = cross(unit_direction(cam.vup), unit_direction(view));
+  if (!(length(side) > 1e-6f)) node.fail("vup is zero or parallel to the viewing direction");
   scene.max_depth = node.has("max_depth") ? node.child("max_depth").integer(1, 10000) : 50;
   scene.background = node.has("background") ? nonnegative_colour(node.child("background")) : Vec3(0.0f);
 }
@@ -286,12 +252,67 @@ std::string content_hash(json doc) {
   return fnv1a_hex(canonical.data(), canonical.size());
 }
 
+// JSON lets an object name a key twice and nlohmann's parser keeps the last
+// value: a scene with two "objects" arrays would lose the first without a
+// word. This follows the parser's events and keeps the path of the first key
+// that appears twice in one object ("objects", "camera.vfov",
+// "materials.white.albedo", "objects[2].q").
+class DuplicateKeys {
+ public:
+  bool operator()(int /*depth*/, json::parse_event_t event, const json& parsed) {
+    using E = json::parse_event_t;
+    switch (event) {
+      case E::object_start: frames_.push_back({true, {}, {}, 0}); break;
+      case E::array_start: frames_.push_back({false, {}, {}, 0}); break;
+      case E::key: {
+        Frame& f = frames_.back();
+        const std::string& key = parsed.get_ref<const std::string&>();
+        if (!f.keys.insert(key).second && first_.empty()) first_ = path_to(key);
+        f.key = key;
+        break;
+      }
+      case E::object_end:
+      case E::array_end:
+        frames_.pop_back();
+        next_element();
+        break;
+      case E::value: next_element(); break;
+    }
+    return true;
+  }
+  // Empty when no key appears twice.
+  const std::string& first() const { return first_; }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;     // an object's current key
+    std::size_t index;   // an array's current element
+  };
+  void next_element() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::string path_to(const std::string& key) const {
+    std::string path;
+    for (std::size_t i = 0; i + 1 < frames_.size(); ++i) {
+      const Frame& f = frames_[i];
+      if (f.object) path += (path.empty() ? "" : ".") + f.key;
+      else path += "[" + std::to_string(f.index) + "]";
+    }
+    return path + (path.empty() ? "" : ".") + key;
+  }
+  std::vector<Frame> frames_;
+  std::string first_;
+};
+
 Scene parse_scene(const std::string& text, const std::string& origin) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(origin + ": the scene is empty (expected a JSON object)");
   json doc;
+  DuplicateKeys duplicates;
   try {
-    doc = json::parse(text);
+    doc = json::parse(text, std::ref(duplicates));
   } catch (const json::parse_error& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."; keep the reason.
     std::string reason = e.what();
@@ -313,6 +334,9 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
     }
     throw InputError(origin + ": JSON error" + where + ": " + reason);
   }
+  if (!duplicates.first().empty())
+    throw InputError(origin + ": " + duplicates.first() +
+                     ": the key appears twice in its object (JSON would keep only the last value)");
   Node root(doc, "", origin);
   root.expect_object();
   root.allow_only({"name", "description", "camera", "materials", "objects"});
@@ -352,25 +376,28 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
 }
 
 Scene load_scene_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw InputError(printable("cannot read scene '" + path + "': it is a folder, not a file"));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(printable("cannot read scene '" + path + "': " + std::strerror(errno)));
+  // A file or a device (/dev/zero is stopped by the size limit); a folder, a
+  // pipe or a socket is refused before anything is read.
+  std::uint64_t size = 0;
+  std::FILE* in = open_input_file(path, "scene", InputKind::FileOrDevice, &size);
   std::string text;
-  // A regular file's size is known: one allocation. A device or a pipe grows
-  // the text chunk by chunk, and is refused before it passes the limit.
-  if (const auto size = std::filesystem::file_size(path, ec); !ec && size <= kMaxSceneBytes)
-    text.reserve(static_cast<std::size_t>(size));
+  // A regular file's size is known: one allocation. A device grows the text
+  // chunk by chunk, and is refused before it passes the limit.
+  if (size <= kMaxSceneBytes) text.reserve(static_cast<std::size_t>(size));
   char chunk[1 << 16];
-  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-    const auto n = static_cast<std::size_t>(in.gcount());
-    if (text.size() + n > kMaxSceneBytes)
-      throw InputError(printable("cannot read scene '" + path + "': larger than " +
-                                 std::to_string(kMaxSceneBytes >> 20) + " MiB; is it a scene file?"));
+  for (;;) {
+    const std::size_t n = std::fread(chunk, 1, sizeof chunk, in);
+    if (text.size() + n > kMaxSceneBytes) {
+      std::fclose(in);
+      throw InputError("cannot read scene '" + path + "': larger than " + std::to_string(kMaxSceneBytes >> 20) +
+                       " MiB; is it a scene file?");
+    }
     text.append(chunk, n);
+    if (n < sizeof chunk) break;
   }
-  if (in.bad()) throw InputError(printable("cannot read scene '" + path + "': read error"));
+  const bool failed = std::ferror(in) != 0;
+  std::fclose(in);
+  if (failed) throw InputError("cannot read scene '" + path + "': read error");
   return load_scene_text(text, path);
 }
 

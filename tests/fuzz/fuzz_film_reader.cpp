@@ -3,7 +3,8 @@
 // file; any other exception, a sanitizer report, a hang, an allocation beyond
 // the input's size, or a film that reads but breaks what merge and resume rely
 // on is a finding. Each input is read twice: as it is, and with its two CRC-32
-// fields recomputed, so that mutations reach the checks behind the checksums.
+// fields recomputed (the second, in version 2, running on from the first), so
+// that mutations reach the checks behind the checksums.
 #include "renderer/error.h"
 #include "renderer/film/film_file.h"
 
@@ -57,7 +58,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto head_crc = static_cast<std::uint32_t>(crc32_z(0, fixed.data(), header_end));
   std::memcpy(fixed.data() + header_end, &head_crc, 4);
   const std::size_t payload = header_end + 4;
-  const auto data_crc = static_cast<std::uint32_t>(crc32_z(0, fixed.data() + payload, size - payload - 4));
+  // Version 1 checksums the data alone; version 2 runs on from the header's CRC.
+  std::uint32_t version = 0;
+  std::memcpy(&version, data + 8, 4);
+  const auto data_crc = static_cast<std::uint32_t>(
+      crc32_z(version == 1 ? 0 : head_crc, fixed.data() + payload, size - payload - 4));
   std::memcpy(fixed.data() + size - 4, &data_crc, 4);
   read_once(fixed.data(), fixed.size());
   return 0;
