@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev openexr zlib1g-dev   # EXR output (openexr: exrheader, which a test reads our files with); film checksums
   parallel                             # scripts/render_parallel.sh fans a render out over job slots or machines
   libgtest-dev libbenchmark-dev
+  universal-ctags   # a test that ctags finds the lane-generic definitions (.ctags.d)
   python3-dev pybind11-dev python3-numpy python3-pytest   # the Python module (python/) and its tests
   python3-matplotlib python3-ipykernel jupyter-nbconvert jupyter-notebook   # the notebooks: run in CI, opened by scripts/notebook.sh
   clang-14 libclang-rt-14-dev   # the fuzzer: clang's libFuzzer and sanitizer runtimes (a recommend, not a dependency)
