@@ -169,9 +169,8 @@ void note_biased_strategies(const std::vector<Strategy>& strategies, bool quiet)
   for (const Strategy& s : strategies)
     if (!s.is_unbiased())
       std::fprintf(stderr,
-                   "note: strategy '%s' is biased (it omits indirect light): its error against the reference "
-                   "stops falling with time\n",
-                   s.to_string().c_str());
+                   "note: strategy '%s' is biased (%s): its error against the reference stops falling with time\n",
+                   s.to_string().c_str(), s.bias_reason().c_str());
 }
 
 std::vector<Result> run_strategies(const BenchPlan& plan, const BenchOptions& o) {

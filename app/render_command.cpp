@@ -310,10 +310,8 @@ Reference checked_reference(const RenderOptions& o, RenderPlan& plan) {
 
 void note_bias(const Strategy& strategy, bool quiet) {
   if (!strategy.is_unbiased() && !quiet)
-    std::fprintf(stderr,
-                 "note: strategy '%s' is biased: its pdf is zero for directions that miss the importance "
-                 "targets, so it omits indirect light\n",
-                 strategy.to_string().c_str());
+    std::fprintf(stderr, "note: strategy '%s' is biased: %s, so its pdf is zero where light may arrive\n",
+                 strategy.to_string().c_str(), strategy.bias_reason().c_str());
 }
 
 // The film's own estimate is noted at fixed sample counts, the powers of two

@@ -12,6 +12,9 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -217,6 +220,38 @@ TEST(Techniques, BiasFollowsTheParameter) {
             "light sees only its targets, uniform-cone:10 reaches only directions within 10 degrees of the normal");
   EXPECT_EQ(Strategy::parse("nee-mis+light").bias_reason(), "its continuation misses light: light sees only its targets");
   EXPECT_TRUE(Strategy::parse("nee-mis+mix:light=1,uniform-cone:90=1").is_unbiased());
+}
+
+// The README's grammar line and technique table are the table's own
+// (technique_grammar, technique_table_markdown), and its "Where is X" table
+// has a row for every technique naming files that exist: a new technique is
+// in the README, or this test says what to paste there.
+TEST(Techniques, ReadmeHoldsTheTable) {
+  std::ifstream in(std::string(PDFLAB_SOURCE_DIR) + "/README.md");
+  ASSERT_TRUE(in) << "README.md";
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string readme = buffer.str();
+  EXPECT_NE(readme.find(technique_grammar() + "\n"), std::string::npos) << "the grammar line should read\n"
+                                                                       << technique_grammar();
+  const std::string begin = "<!-- the technique table: ", end = "<!-- end of the technique table -->";
+  const std::size_t b = readme.find(begin), e = readme.find(end);
+  ASSERT_NE(b, std::string::npos);
+  ASSERT_NE(e, std::string::npos);
+  const std::size_t first_row = readme.find('\n', b) + 1;
+  EXPECT_EQ(readme.substr(first_row, e - first_row), technique_table_markdown())
+      << "README.md's technique table should read\n" << technique_table_markdown();
+  const std::size_t where = readme.find("### Where is X");
+  ASSERT_NE(where, std::string::npos);
+  const std::string section = readme.substr(where, readme.find("\n### ", where + 1) - where);
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const std::string row = "\n| `" + std::string(technique_info(static_cast<Technique>(i)).name) + "` | `";
+    const std::size_t at = section.find(row);
+    ASSERT_NE(at, std::string::npos) << "no row in \"Where is X\" for " << technique_info(static_cast<Technique>(i)).name;
+    const std::size_t path = at + row.size(), path_end = section.find('`', path);
+    EXPECT_TRUE(std::filesystem::exists(std::string(PDFLAB_SOURCE_DIR) + "/" + section.substr(path, path_end - path)))
+        << section.substr(path, path_end - path);
+  }
 }
 
 }  // namespace

@@ -95,33 +95,33 @@ float parse_weight(std::string_view text, std::string_view whole) {
   return value;
 }
 
-// " (biased alone: it REASON)" for --help, at the parameter's default; for a
-// technique biased alone at some of its parameter's values only, also an end
-// of the range where it is not (or is).
-std::string bias_help(const TechniqueInfo& t) {
+// "biased alone: it REASON" at the parameter's default; for a technique
+// biased alone at some of its parameter's values only, also an end of the
+// range where it is not (or is). Empty where it is unbiased alone.
+std::string bias_text(const TechniqueInfo& t) {
   const std::string at_default = t.bias_alone(t.parameter_default);
   const float ends[] = {t.parameter_min, t.parameter_max};
   for (const float end : ends) {
     if (t.parameter.empty() || t.bias_alone(end).empty() == at_default.empty()) continue;
     const std::string at = std::string(t.parameter) + " = " + format_number(end);
-    if (at_default.empty()) return " (biased alone at " + at + ": it " + t.bias_alone(end) + ")";
-    return " (biased alone: it " + at_default + "; unbiased at " + at + ")";
+    if (at_default.empty()) return "biased alone at " + at + ": it " + t.bias_alone(end);
+    return "biased alone: it " + at_default + "; unbiased at " + at;
   }
-  return at_default.empty() ? "" : " (biased alone: it " + at_default + ")";
+  return at_default.empty() ? "" : "biased alone: it " + at_default;
 }
 
-// " (alone: infinite variance, as REASON; finite at P = X)" for --help, at the
-// parameter's default.
-std::string heavy_tail_help(const TechniqueInfo& t) {
+// "alone on a diffuse surface: infinite variance, as REASON; finite at P = X"
+// at the parameter's default; empty where the variance is finite.
+std::string heavy_tail_text(const TechniqueInfo& t) {
   const std::string at_default = t.heavy_tail_alone(t.parameter_default);
   if (at_default.empty()) return "";
-  std::string out = " (alone on a diffuse surface: infinite variance, as " + at_default;
+  std::string out = "alone on a diffuse surface: infinite variance, as " + at_default;
   for (const float end : {t.parameter_min, t.parameter_max})
     if (!t.parameter.empty() && t.heavy_tail_alone(end).empty()) {
       out.append("; finite at ").append(t.parameter).append(" = ").append(format_number(end));
       break;
     }
-  return out + ")";
+  return out;
 }
 
 }  // namespace
@@ -131,6 +131,42 @@ std::string_view technique_name(Technique t) { return kTable[static_cast<int>(t)
 
 std::string stratified_vertices() {
   return qmc::kDepths == 1 ? "the first vertex's" : "the first " + std::to_string(qmc::kDepths) + " vertices'";
+}
+
+namespace {
+// A technique as typed: name, or name[:P] for one with a parameter.
+std::string spelled_with_parameter(const TechniqueInfo& t) {
+  std::string name(t.name);
+  if (!t.parameter.empty()) name.append("[:").append(t.parameter).append("]");
+  return name;
+}
+// "; P in [min, max], default d", or nothing.
+std::string parameter_help(const TechniqueInfo& t) {
+  if (t.parameter.empty()) return "";
+  return "; " + std::string(t.parameter) + " in [" + format_number(t.parameter_min) + ", " +
+         format_number(t.parameter_max) + "], default " + format_number(t.parameter_default);
+}
+// What the technique is alone: its bias and its variance, or "unbiased".
+std::string alone_text(const TechniqueInfo& t) {
+  const std::string bias = bias_text(t), tail = heavy_tail_text(t);
+  if (bias.empty() && tail.empty()) return "unbiased";
+  return bias + (bias.empty() || tail.empty() ? "" : "; ") + tail;
+}
+}  // namespace
+
+std::string technique_grammar() {
+  std::string out = "TECHNIQUE := ";
+  for (std::size_t i = 0; i < kTable.size(); ++i)
+    out.append(i ? " | " : "").append(spelled_with_parameter(kTable[i]));
+  return out;
+}
+
+std::string technique_table_markdown() {
+  std::string out = "| technique | draws | pdf | alone |\n|---|---|---|---|\n";
+  for (const TechniqueInfo& t : kTable)
+    out.append("| `").append(spelled_with_parameter(t)).append("` | ").append(t.draws).append(parameter_help(t))
+        .append(" | `").append(t.pdf).append("` | ").append(alone_text(t)).append(" |\n");
+  return out;
 }
 
 std::string strategy_help() {
@@ -153,15 +189,12 @@ std::string strategy_help() {
       "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +
       "\nTechniques:\n";
   for (const TechniqueInfo& t : kTable) {
-    std::string name(t.name);
-    if (!t.parameter.empty())
-      name.append("[:").append(t.parameter).append("]");
+    const std::string name = spelled_with_parameter(t);
     out.append("  ").append(name).append(name.size() < 22 ? 22 - name.size() : 1, ' ');
-    out.append(t.draws).append("; pdf ").append(t.pdf);
-    if (!t.parameter.empty())
-      out.append("; ").append(t.parameter).append(" in [").append(format_number(t.parameter_min)).append(", ")
-          .append(format_number(t.parameter_max)).append("], default ").append(format_number(t.parameter_default));
-    out.append(bias_help(t)).append(heavy_tail_help(t)).append("\n");
+    out.append(t.draws).append("; pdf ").append(t.pdf).append(parameter_help(t));
+    for (const std::string& note : {bias_text(t), heavy_tail_text(t)})
+      if (!note.empty()) out.append(" (").append(note).append(")");
+    out.append("\n");
   }
   return out;
 }

@@ -23,6 +23,11 @@ const TechniqueInfo& technique_info(Technique t);
 // The strategy grammar and every technique in the table (what it draws, its
 // pdf, whether it is biased alone): the text of `--help`.
 std::string strategy_help();
+// The TECHNIQUE := line of the grammar, and the technique table as Markdown
+// (name, what it draws, its pdf, whether it is biased or heavy-tailed alone):
+// README.md holds both, and a test checks them against these.
+std::string technique_grammar();
+std::string technique_table_markdown();
 // Which vertices the `+sobol` sampler stratifies, in words ("the first
 // vertex's", from qmc::kDepths), for the help and the panel.
 std::string stratified_vertices();
