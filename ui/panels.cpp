@@ -134,45 +134,44 @@ void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int
   }
 }
 
-void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
-  SamplingSettings& s = settings.sampling;
-  const SamplingSettings before = s;
-
-  // Combo: each technique alone, then the mixture.
+// The strategy drop-down: each technique alone, then the mixture, then nee-mis
+// with either heuristic.
+void strategy_combo(SamplingSettings& s) {
   std::string current = s.mixture ? "mixture" : std::string(technique_name(s.single));
   if (s.nee_mis) current = s.heuristic == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
-  if (ImGui::BeginCombo("Strategy", current.c_str())) {
-    for (int i = 0; i < kTechniqueCount; ++i) {
-      const auto t = static_cast<Technique>(i);
-      std::string name(technique_name(t));
-      if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
-      if (ImGui::Selectable(name.c_str(), !s.nee_mis && !s.mixture && s.single == t)) {
-        s.nee_mis = false;
-        s.mixture = false;
-        s.single = t;
-      }
-    }
-    if (ImGui::Selectable("mixture", !s.nee_mis && s.mixture)) {
+  if (!ImGui::BeginCombo("Strategy", current.c_str())) return;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const auto t = static_cast<Technique>(i);
+    std::string name(technique_name(t));
+    if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
+    if (ImGui::Selectable(name.c_str(), !s.nee_mis && !s.mixture && s.single == t)) {
       s.nee_mis = false;
-      if (!s.mixture) {
-        // Start the mixture from what was shown, so the image does not jump.
-        s.weights = {};
-        s.weights[static_cast<int>(s.single)] = 1.0f;
-      }
-      s.mixture = true;
+      s.mixture = false;
+      s.single = t;
     }
-    ImGui::Separator();
-    for (const MisHeuristic h : {MisHeuristic::Power, MisHeuristic::Balance}) {
-      const char* label = h == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
-      if (ImGui::Selectable(label, s.nee_mis && s.heuristic == h)) {
-        s.nee_mis = true;
-        s.heuristic = h;
-      }
-    }
-    ImGui::EndCombo();
   }
+  if (ImGui::Selectable("mixture", !s.nee_mis && s.mixture)) {
+    s.nee_mis = false;
+    if (!s.mixture) {
+      // Start the mixture from what was shown, so the image does not jump.
+      s.weights = {};
+      s.weights[static_cast<int>(s.single)] = 1.0f;
+    }
+    s.mixture = true;
+  }
+  ImGui::Separator();
+  for (const MisHeuristic h : {MisHeuristic::Power, MisHeuristic::Balance}) {
+    const char* label = h == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
+    if (ImGui::Selectable(label, s.nee_mis && s.heuristic == h)) {
+      s.nee_mis = true;
+      s.heuristic = h;
+    }
+  }
+  ImGui::EndCombo();
+}
 
-  // A slider for each parameter a technique in use takes (cosine-power's N).
+// A slider for each parameter a technique in use takes (cosine-power's N).
+void technique_parameters(SamplingSettings& s) {
   for (int i = 0; i < kTechniqueCount && !s.nee_mis; ++i) {
     const TechniqueInfo& t = technique_info(static_cast<Technique>(i));
     const bool used = s.mixture ? s.weights[i] > 0.0f : s.single == static_cast<Technique>(i);
@@ -183,44 +182,50 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
                        ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
     ImGui::PopID();
   }
+}
 
-  if (s.nee_mis) draw_nee_explanation();
-  if (s.mixture && !s.nee_mis) {
-    // The book's two-technique mixture as one number: w * A + (1 - w) * B.
-    state.w_pair = two_technique_pair(s, state.w_pair);
-    if (state.w_pair[0] >= 0) {
-      const int a = state.w_pair[0], b = state.w_pair[1];
-      const float sum = s.weights[a] + s.weights[b];
-      float w = sum > 0.0f ? s.weights[a] / sum : 0.5f;
-      ImGui::TextColored(kDim, "w\xc2\xb7%s + (1-w)\xc2\xb7%s", std::string(technique_name(static_cast<Technique>(a))).c_str(),
-                         std::string(technique_name(static_cast<Technique>(b))).c_str());
-      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-      if (ImGui::SliderFloat("w##pair", &w, 0.0f, 1.0f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
-        s.weights[a] = w;
-        s.weights[b] = 1.0f - w;
-      }
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
-      draw_weight_curve(settings, status.weights, a, b);
-    }
-    const auto norm = s.normalised();
-    ImGui::TextColored(kDim, "weight per technique         fraction");
-    for (int i = 0; i < kTechniqueCount; ++i) {
-      ImGui::PushID(i);
-      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-      const std::string name(technique_name(static_cast<Technique>(i)));
-      ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.3g").c_str(), ImGuiSliderFlags_AlwaysClamp);
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Raw weight; the renderer normalises. Ctrl+click to type one.");
-      ImGui::SameLine();
-      if (norm[i] > 0.0f) ImGui::Text("%.1f%%", norm[i] * 100.0f);
-      else ImGui::TextColored(kDim, "0%%");
-      ImGui::PopID();
-    }
-    bool any = false;
-    for (float w : s.weights) any = any || w > 0.0f;
-    if (!any) ImGui::TextColored(kRed, "All weights are 0: the image keeps the last valid mixture.");
+// The book's two-technique mixture as one number, w * A + (1 - w) * B, with
+// the predicted curve beside it.
+void pair_weight_slider(ViewerSettings& settings, PanelState& state, const UiStatus& status) {
+  SamplingSettings& s = settings.sampling;
+  state.w_pair = two_technique_pair(s, state.w_pair);
+  if (state.w_pair[0] < 0) return;
+  const int a = state.w_pair[0], b = state.w_pair[1];
+  const float sum = s.weights[a] + s.weights[b];
+  float w = sum > 0.0f ? s.weights[a] / sum : 0.5f;
+  ImGui::TextColored(kDim, "w\xc2\xb7%s + (1-w)\xc2\xb7%s", std::string(technique_name(static_cast<Technique>(a))).c_str(),
+                     std::string(technique_name(static_cast<Technique>(b))).c_str());
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+  if (ImGui::SliderFloat("w##pair", &w, 0.0f, 1.0f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
+    s.weights[a] = w;
+    s.weights[b] = 1.0f - w;
   }
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
+  draw_weight_curve(settings, status.weights, a, b);
+}
 
-  // The presets' buttons in a row that wraps where the panel ends.
+// One raw weight slider per technique, each with its fraction of the mixture.
+void mixture_weights(SamplingSettings& s) {
+  const auto norm = s.normalised();
+  ImGui::TextColored(kDim, "weight per technique         fraction");
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    ImGui::PushID(i);
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+    const std::string name(technique_name(static_cast<Technique>(i)));
+    ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.3g").c_str(), ImGuiSliderFlags_AlwaysClamp);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Raw weight; the renderer normalises. Ctrl+click to type one.");
+    ImGui::SameLine();
+    if (norm[i] > 0.0f) ImGui::Text("%.1f%%", norm[i] * 100.0f);
+    else ImGui::TextColored(kDim, "0%%");
+    ImGui::PopID();
+  }
+  bool any = false;
+  for (float w : s.weights) any = any || w > 0.0f;
+  if (!any) ImGui::TextColored(kRed, "All weights are 0: the image keeps the last valid mixture.");
+}
+
+// The presets' buttons in a row that wraps where the panel ends.
+void preset_buttons(SamplingSettings& s) {
   const ImGuiStyle& style = ImGui::GetStyle();
   const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
   const auto flow_button = [&](const char* label, bool first) {
@@ -237,8 +242,10 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
   if (flow_button("fastest", false)) s = fastest_sampling();
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("pdflab's most efficient unbiased strategy for general scenes: %s", kFastestStrategy.data());
+}
 
-  // Russian roulette, for any strategy.
+// Russian roulette and the Sobol sampler, for any strategy.
+void path_options(SamplingSettings& s) {
   bool roulette = s.roulette_depth > 0;
   if (ImGui::Checkbox("Russian roulette", &roulette)) s.roulette_depth = roulette ? kDefaultRouletteDepth : 0;
   if (ImGui::IsItemHovered())
@@ -249,45 +256,64 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
     ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
     ImGui::SliderInt("from depth", &s.roulette_depth, 1, 20, "%d", ImGuiSliderFlags_AlwaysClamp);
   }
-  // The stratified sampler, for any strategy.
   ImGui::Checkbox("Sobol sampler", &s.sobol);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Owen-scrambled Sobol points for %s random numbers, stratified\n"
                       "across each pixel's samples (+sobol); off: every number independent",
                       stratified_vertices().c_str());
+}
 
+// The strategy as `pdflab render --strategy` takes it, wrapped before a '+'
+// where it is wider than the panel (fastest's is), never inside a weight; the
+// bias label after it, on the next line if it does not fit.
+void strategy_line(const SamplingSettings& s) {
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;
   for (float w : strategy.weights) any = any || w > 0.0f;
-  if (any) {
-    // Wrapped before a '+' where it is wider than the panel (fastest's is), never
-    // inside a weight; the bias label after it, on the next line if it does not fit.
-    const std::string text = strategy.to_string();
-    const float line_end = ImGui::GetCursorScreenPos().x + ImGui::GetContentRegionAvail().x;
-    const auto same_line_if_fits = [&](const char* next, float spacing) {
-      ImGui::SameLine(0.0f, spacing);
-      if (ImGui::GetCursorScreenPos().x + ImGui::CalcTextSize(next).x > line_end) ImGui::NewLine();
-    };
-    bool hovered = false;
-    for (std::size_t begin = 0; begin < text.size();) {
-      const std::size_t end = std::min(text.find('+', begin + 1), text.size());
-      const std::string piece = text.substr(begin, end - begin);
-      if (begin > 0) same_line_if_fits(piece.c_str(), 0.0f);
-      ImGui::TextUnformatted(piece.c_str());
-      hovered = hovered || ImGui::IsItemHovered();
-      begin = end;
-    }
-    if (hovered) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
-    same_line_if_fits(strategy.is_unbiased() ? "unbiased" : "BIASED", ImGui::GetStyle().ItemSpacing.x);
-    if (strategy.is_unbiased()) {
-      ImGui::TextColored(kGreen, "unbiased");
-    } else {
-      ImGui::TextColored(kRed, "BIASED");
-      ImGui::PushStyleColor(ImGuiCol_Text, kRed);
-      ImGui::TextWrapped("Its pdf is zero away from the importance targets, so indirect light is missing.");
-      ImGui::PopStyleColor();
-    }
+  if (!any) return;
+  const std::string text = strategy.to_string();
+  const float line_end = ImGui::GetCursorScreenPos().x + ImGui::GetContentRegionAvail().x;
+  const auto same_line_if_fits = [&](const char* next, float spacing) {
+    ImGui::SameLine(0.0f, spacing);
+    if (ImGui::GetCursorScreenPos().x + ImGui::CalcTextSize(next).x > line_end) ImGui::NewLine();
+  };
+  bool hovered = false;
+  for (std::size_t begin = 0; begin < text.size();) {
+    const std::size_t end = std::min(text.find('+', begin + 1), text.size());
+    const std::string piece = text.substr(begin, end - begin);
+    if (begin > 0) same_line_if_fits(piece.c_str(), 0.0f);
+    ImGui::TextUnformatted(piece.c_str());
+    hovered = hovered || ImGui::IsItemHovered();
+    begin = end;
   }
+  if (hovered) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
+  same_line_if_fits(strategy.is_unbiased() ? "unbiased" : "BIASED", ImGui::GetStyle().ItemSpacing.x);
+  if (strategy.is_unbiased()) {
+    ImGui::TextColored(kGreen, "unbiased");
+  } else {
+    ImGui::TextColored(kRed, "BIASED");
+    ImGui::PushStyleColor(ImGuiCol_Text, kRed);
+    ImGui::TextWrapped("Its pdf is zero away from the importance targets, so indirect light is missing.");
+    ImGui::PopStyleColor();
+  }
+}
+
+// The Sampling section, in the order it reads: the strategy, its parameters,
+// its weights, the presets, the path options, the strategy as text; any edit
+// restarts the render.
+void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
+  SamplingSettings& s = settings.sampling;
+  const SamplingSettings before = s;
+  strategy_combo(s);
+  technique_parameters(s);
+  if (s.nee_mis) draw_nee_explanation();
+  if (s.mixture && !s.nee_mis) {
+    pair_weight_slider(settings, state, status);
+    mixture_weights(s);
+  }
+  preset_buttons(s);
+  path_options(s);
+  strategy_line(s);
   if (!status.settings_error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kRed);
     ImGui::TextWrapped("%s", status.settings_error.c_str());
