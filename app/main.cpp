@@ -122,8 +122,21 @@ int main(int argc, char** argv) {
   app.add_option("--reference", view_reference,
                  "Reference image (PFM) for live error figures in the viewer (default: the cached one, if any)");
   double view_make_seconds = 0.0;
-  app.add_option("--reference-seconds", view_make_seconds, "Rendering time that Make reference starts with (30)")
+  app.add_option("--reference-seconds", view_make_seconds, "The time limit Make reference starts with (120)")
       ->check(positive_number(" of seconds"));
+  std::string view_window, view_layout_json;
+  app.add_option("--window", view_window, "Window size WxH, e.g. 1280x720 (default: as last time, else fit the image)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            int w = 0, h = 0;
+            char x = 0, rest = 0;
+            if (std::sscanf(v.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X') || w < 200 ||
+                h < 200 || w > 16384 || h > 16384)
+              return "must be WIDTHxHEIGHT with each side in 200..16384, not '" + v + "'";
+            return std::string();
+          },
+          "WxH"));
+  app.add_option("--layout-json", view_layout_json, "Write the viewer's layout (panel, overlays, controls) to this JSON file");
 
   pdflab::RenderOptions ro;
   CLI::App* render = app.add_subcommand("render", "Render headlessly to an image file");
@@ -282,6 +295,10 @@ int main(int argc, char** argv) {
     vo.auto_weight = view_auto_weight;
     vo.view = view_mode;
     vo.make_reference_seconds = view_make_seconds;
+    char x = 0;
+    if (!view_window.empty()) std::sscanf(view_window.c_str(), "%d%c%d", &vo.window_width, &x, &vo.window_height);
+    vo.layout_json = view_layout_json;
+    vo.remember = true;
     return pdflab::run_viewer(vo);
 #else
     // Built without the viewer: render the default scene headlessly instead.
