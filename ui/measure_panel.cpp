@@ -495,10 +495,11 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
   if (m->reference.loaded()) {
     const ReferenceInfo& ri = m->reference.info;
     char line[200];
-    std::snprintf(line, sizeof line, "reference: %s, %dx%d, %u spp%s",
+    const std::string spp = ri.spp > 0 ? ", " + std::to_string(ri.spp) + " spp" : std::string();
+    std::snprintf(line, sizeof line, "reference: %s, %dx%d%s%s",
                   m->reference_from_cache ? "from the cache"
                                           : std::filesystem::path(m->reference.path).filename().string().c_str(),
-                  m->reference.width, m->reference.height, ri.spp,
+                  m->reference.width, m->reference.height, spp.c_str(),
                   m->reference.has_variance() ? "" : ", no variance");
     const float drop_w = ImGui::CalcTextSize("Drop").x + style.FramePadding.x * 2.0f + style.ItemSpacing.x;
     one_line(line, kDim, drop_w);
@@ -601,7 +602,9 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
 
 void draw_nee_explanation(const SamplingSettings& s) {
   // Closed at first: the note is long, the panel is for controls.
-  if (!ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None)) return;
+  const bool open = ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None);
+  layout::item("sampling.nee_why");
+  if (!open) return;
   // What continues the path: cosine alone (plain nee-mis) or a mixture (fastest's).
   const Strategy strategy = s.strategy();
   std::string continuation;

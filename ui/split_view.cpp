@@ -28,17 +28,23 @@ void side_box(const char* id, const char* side, const SideFigures& f, Corner cor
   else
     std::snprintf(lines[3], sizeof lines[3], "efficiency %s%s", format_figure(f.efficiency()).c_str(),
                   f.efficiency_from_reference() ? "" : " est.");
-  const std::string head = std::string(side) + "  " + f.strategy + (f.unbiased ? "" : "  biased");
-  float natural = ImGui::CalcTextSize(head.c_str()).x;
+  // As drawn: the side's letter, then the strategy on the same line.
+  float natural = ImGui::CalcTextSize(side).x + ImGui::GetStyle().ItemSpacing.x + ImGui::CalcTextSize(f.strategy.c_str()).x + 1.0f;
   for (const auto& l : lines) natural = std::max(natural, ImGui::CalcTextSize(l).x);
+  const ImGuiStyle& style = ImGui::GetStyle();
   layout::Overlay o;
   o.corner = corner;
-  o.width = natural + 2.0f * ImGui::GetStyle().WindowPadding.x;
-  o.height = layout::text_height(5 + (f.unbiased ? 0 : 1));
-  o.min_width = 7.0f;
-  o.min_lines = 3.0f;
+  o.width = natural + 2.0f * style.WindowPadding.x;
   // Each within its own half of the area: A's box never reaches over B's side.
   o.max_width = layout::area().w * 0.5f - ImGui::GetFontSize();
+  // Its height at that width: the strategy (a long mixture) may wrap.
+  const float text_w = std::min(o.width, o.max_width) - 2.0f * style.WindowPadding.x;
+  const float strategy_w = std::max(1.0f, text_w - ImGui::CalcTextSize(side).x - style.ItemSpacing.x);
+  const float strategy_lines =
+      std::ceil(ImGui::CalcTextSize(f.strategy.c_str(), nullptr, false, strategy_w).y / ImGui::GetTextLineHeight());
+  o.height = layout::text_height(static_cast<int>(std::max(1.0f, strategy_lines)) + 4 + (f.unbiased ? 0 : 1));
+  o.min_width = 7.0f;
+  o.min_lines = 3.0f;
   float wrap = 0.0f;
   if (!layout::place_next_window(id, o, &wrap)) return;
   ImGui::SetNextWindowBgAlpha(0.72f);

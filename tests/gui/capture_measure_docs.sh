@@ -60,6 +60,7 @@ stop
 
 # The nee-mis note is in the panel; the plot and views stay out of the way.
 start_viewer "$pdflab" --scene "$scene" --strategy nee-mis:balance
+click sampling.nee_why
 sleep 4
 shot nee_mis_note.png
 stop

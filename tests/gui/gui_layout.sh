@@ -22,6 +22,20 @@ pdflab=$1 scene=$2 art=$3 docs=${4:-}
 rm -rf "$art"
 mkdir -p "$art"
 
+# drag_splitter DX: drags the panel's edge DX pixels to the left. The pointer
+# rests on the edge before the button goes down, and between steps, so that a
+# slow frame on a loaded machine still sees the press on the edge.
+drag_splitter() {
+  local x y dx
+  read -r x y <<<"$(centre panel.splitter)"
+  xdotool mousemove "$x" "$y"
+  sleep 0.4
+  xdotool mousedown 1
+  sleep 0.4
+  for dx in $(seq 10 10 "$1"); do xdotool mousemove "$((x - dx))" "$y"; sleep 0.08; done
+  sleep 0.4
+  xdotool mouseup 1
+}
 # image_centre: "x y" of the image's middle, from the report.
 image_centre() { layout_py "'%d %d' % (d['image']['x'] + d['image']['w'] / 2, d['image']['y'] + d['image']['h'] / 2)"; }
 
@@ -110,7 +124,10 @@ scene_rows="$((pw - 30))x$((ey + eh - sy))+$((px + 10))+$sy"
 shot scene_before "$scene_rows"
 curve=$(crop_of sampling.curve)
 read -r wx wy ww wh <<<"$(item sampling.w)"
-xdotool mousemove "$((wx + ww / 2))" "$((wy + wh / 2))" mousedown 1
+xdotool mousemove "$((wx + ww / 2))" "$((wy + wh / 2))"
+sleep 0.4
+xdotool mousedown 1
+sleep 0.4
 for dx in 10 25 40 60 80 60 40; do
   xdotool mousemove "$((wx + ww / 2 + dx))" "$((wy + wh / 2))"
   sleep 0.3
@@ -134,12 +151,8 @@ echo "curve box while dragging: stddev $sd"
 awk -v s="$sd" 'BEGIN { exit !(s > 0.05) }' || fail "the curve's box went blank while w was dragged"
 
 echo "== the panel resizes by its edge, hides by its button and by Tab"
-read -r x0 _ _ _ <<<"$(item panel)"
 width0=$(layout_py "int(d['items']['panel']['w'])")
-read -r ex ey ew eh <<<"$(item panel.splitter)"
-xdotool mousemove "$((ex + ew / 2))" "$((ey + eh / 2))" mousedown 1
-for dx in 20 60 100 140; do xdotool mousemove "$((ex + ew / 2 - dx))" "$((ey + eh / 2))"; sleep 0.1; done
-xdotool mouseup 1
+drag_splitter 140
 xdotool mousemove 2 2
 await_layout "d['items']['panel']['w'] >= $width0 + 120"
 width1=$(layout_py "int(d['items']['panel']['w'])")
@@ -166,13 +179,9 @@ viewer_config=$(mktemp -d -t pdflab-config-XXXXXX)
 at_exit="rm -rf '$viewer_config'"
 start_viewer "$pdflab" --scene "$scene" --window 1500x900
 await_layout "'section.1' in d['items']"
-xdotool mousemove "$((ex - 50))" "$((ey + eh / 2))"
-read -r ex ey ew eh <<<"$(item panel.splitter)"
-xdotool mousemove "$((ex + ew / 2))" "$((ey + eh / 2))" mousedown 1
-for dx in 20 60 100; do xdotool mousemove "$((ex + ew / 2 - dx))" "$((ey + eh / 2))"; sleep 0.1; done
-xdotool mouseup 1
+drag_splitter 100
 xdotool mousemove 2 2
-sleep 0.5
+await_layout "d['items']['panel']['w'] >= 480"
 remembered_width=$(layout_py "int(d['items']['panel']['w'])")
 click section.1
 await_layout "'scene.combo' not in d['items']"
@@ -180,7 +189,7 @@ quit_viewer
 start_viewer "$pdflab" --scene "$scene"
 await_layout "d['window']['width'] == 1500 and d['window']['height'] == 900" ||
   fail "the window's size was not remembered"
-await_layout "abs(d['items']['panel']['w'] - $remembered_width) <= 1" 
+await_layout "abs(d['items']['panel']['w'] - $remembered_width) <= 1"
 await_layout "'scene.combo' not in d['items'] and 'sampling.strategy' in d['items']"
 echo "window 1500x900, panel $remembered_width wide and Scene and render closed, as left"
 quit_viewer
