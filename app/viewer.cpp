@@ -167,8 +167,9 @@ struct Viewer::Impl {
   GLFWkeyfun imgui_key_callback = nullptr;  // ImGui's, which calls ours first
   struct Release {
     int key = 0, scancode = 0, mods = 0;
+    bool seen = false;  // ImGui's NewFrame has seen the key down since
   };
-  std::vector<int> pressed_this_frame;
+  std::vector<int> pressed_this_frame;  // pressed since ImGui's last NewFrame
   std::vector<Release> deferred_releases;
   // Redrawing costs CPU time the render threads could use (and llvmpipe draws
   // on the CPU), so a frame is drawn only when something on it can change.
@@ -1330,10 +1331,15 @@ void Viewer::Impl::service_auto_weight() {
 }
 
 void Viewer::Impl::handle_input() {
-  // Last frame's quick releases first (see open_window), then the new events.
-  pressed_this_frame.clear();
-  for (const Release& r : std::exchange(deferred_releases, {}))
-    if (imgui_key_callback) imgui_key_callback(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+  // Quick releases whose press a frame has seen first (see open_window), then
+  // the new events. A press and release both taken while the last frame waited
+  // (pace) are not seen yet: replayed now, ImGui would never see the key down.
+  std::vector<Release> unseen;
+  for (const Release& r : std::exchange(deferred_releases, {})) {
+    if (!r.seen) unseen.push_back(r);
+    else if (imgui_key_callback) imgui_key_callback(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+  }
+  deferred_releases = std::move(unseen);
   glfwPollEvents();
   pending_keys.insert(pending_keys.end(), keys.begin(), keys.end());
   keys.clear();
@@ -1581,6 +1587,9 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
+  // The keys down now have been seen: their releases may follow next frame.
+  v.pressed_this_frame.clear();
+  for (Impl::Release& r : v.deferred_releases) r.seen = true;
   if (v.close_popups) ImGui::ClosePopupToLevel(0, true);
   v.close_popups = false;
   v.fill_status();

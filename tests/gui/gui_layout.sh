@@ -175,8 +175,7 @@ await_layout "'display.view' in d['items']"
 quit_viewer
 
 echo "== the next run comes back as it was left"
-viewer_config=$(mktemp -d -t pdflab-config-XXXXXX)
-at_exit="rm -rf '$viewer_config'"
+viewer_config=$art/remembered
 start_viewer "$pdflab" --scene "$scene" --window 1500x900
 await_layout "'section.1' in d['items']"
 drag_splitter 100

@@ -53,11 +53,16 @@ focus_window() {
 # one). Environment assignments before it reach the viewer.
 viewer_config=
 layout=
+gui_tmp=      # the reports and settings folders of this script's viewers, removed at exit
+viewer_starts=0
 start_viewer() {
   # The last viewer's window must be gone, or the search could find it.
   for _ in $(seq 50); do xdotool search --name '^pdflab' >/dev/null 2>&1 || break; sleep 0.1; done
-  layout=$(mktemp -u -t pdflab-layout-XXXXXX.json)
-  local config=${viewer_config:-$(mktemp -d -t pdflab-config-XXXXXX)}
+  [ -n "$gui_tmp" ] || gui_tmp=$(mktemp -d -t pdflab-gui-XXXXXX)
+  viewer_starts=$((viewer_starts + 1))
+  layout=$gui_tmp/layout-$viewer_starts.json
+  local config=${viewer_config:-$gui_tmp/config-$viewer_starts}
+  mkdir -p "$config"
   PDFLAB_CONFIG_DIR="$config" "$@" --layout-json "$layout" &
   viewer=$!
   focus_window
@@ -66,7 +71,7 @@ start_viewer() {
 }
 viewer=
 at_exit=  # more to do when the script ends (e.g. remove a temporary folder)
-trap '[ -z "$viewer" ] || kill "$viewer" 2>/dev/null || true; eval "$at_exit"' EXIT
+trap '[ -z "$viewer" ] || kill "$viewer" 2>/dev/null || true; eval "$at_exit"; [ -z "$gui_tmp" ] || rm -rf "$gui_tmp"' EXIT
 
 # quit_viewer: Ctrl+Q, and Ctrl+Q again ("quit anyway") when it asks first (a
 # render of more than a few seconds, unsaved); waits for the exit status,
