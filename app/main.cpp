@@ -89,6 +89,7 @@ struct ViewerCommand {
   float ui_scale = 1.0f;
   bool presentation = false, auto_weight = false;
   double make_reference_seconds = 0.0;
+  std::string window, layout_json;
   CLI::Option* strategy_option = nullptr;
 };
 
@@ -111,8 +112,20 @@ void add_viewer_options(CLI::App& app, ViewerCommand& v) {
   app.add_option("--reference", v.reference,
                  "Reference (a .pfm, .exr or .film) for live error figures in the viewer (default: the cached one, "
                  "if any)");
-  app.add_option("--reference-seconds", v.make_reference_seconds, "Rendering time that Make reference starts with (30)")
+  app.add_option("--reference-seconds", v.make_reference_seconds, "The time limit Make reference starts with (120)")
       ->check(positive_number(" of seconds"));
+  app.add_option("--window", v.window, "Window size WxH, e.g. 1280x720 (default: as last time, else fit the image)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            int w = 0, h = 0;
+            char x = 0, rest = 0;
+            if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X') || w < 200 ||
+                h < 200 || w > 16384 || h > 16384)
+              return "must be WIDTHxHEIGHT with each side in 200..16384, not '" + text + "'";
+            return std::string();
+          },
+          "WxH"));
+  app.add_option("--layout-json", v.layout_json, "Write the viewer's layout (panel, overlays, controls) to this JSON file");
 }
 
 // `render`, with what was typed and what was left to its default.
@@ -345,6 +358,10 @@ int run_viewer_command(const ViewerCommand& v) {
   vo.auto_weight = v.auto_weight;
   vo.view = v.mode;
   vo.make_reference_seconds = v.make_reference_seconds;
+  char x = 0;
+  if (!v.window.empty()) std::sscanf(v.window.c_str(), "%d%c%d", &vo.window_width, &x, &vo.window_height);
+  vo.layout_json = v.layout_json;
+  vo.remember = true;
   return pdflab::run_viewer(vo);
 }
 #else

@@ -3,6 +3,7 @@
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
+#include "ui/layout_report.h"
 
 #include <glad/gl.h>
 #define GLFW_INCLUDE_NONE
@@ -217,7 +218,7 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
   bool mouse_taken = false;
   if (split_.on) {
     ui::SplitRequests requests;
-    ui::draw_split_controls(split_, requests, area_width, area_height);
+    ui::draw_split_controls(split_, requests);
     const bool free_mouse = !io.WantCaptureMouse || split_.divider.dragging;
     mouse_taken = free_mouse && split_.divider.update(io.MousePos.x, io.MousePos.y, ImGui::IsMouseClicked(0),
                                                       ImGui::IsMouseDown(0), left, top, width, height, 10.0f);
@@ -251,15 +252,25 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
   ui::draw_probe_panel(probe_, now, area_width, area_height);
   if (was_open && !probe_.open) probe_.mode = false;  // its close button ends probing
   if (probe_.mode) {
-    // Bottom-left: the probe panel opens at the top right.
-    ImGui::SetNextWindowPos(ImVec2(8.0f, area_height - 8.0f), ImGuiCond_Always, ImVec2(0.0f, 1.0f));
-    ImGui::SetNextWindowBgAlpha(0.6f);
-    const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoInputs |
-                                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
-    if (ImGui::Begin("##probe_badge", nullptr, flags))
-      ImGui::TextColored(ImVec4(0.45f, 0.95f, 0.55f, 1.0f), "probe mode: click a pixel (P or Esc to leave)");
-    ImGui::End();
+    // Bottom left, placed with the other boxes over the image: the probe
+    // panel opens at the top right.
+    const char* text = "probe mode: click a pixel (P or Esc to leave)";
+    ui::layout::Overlay o;
+    o.corner = ui::Corner::BottomLeft;
+    o.width = ImGui::CalcTextSize(text).x + 2.0f * ImGui::GetStyle().WindowPadding.x;
+    float wrap = 0.0f;
+    if (ui::layout::place_next_window("##probe_badge", o, &wrap)) {
+      ImGui::SetNextWindowBgAlpha(0.6f);
+      const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoInputs |
+                                     ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
+      if (ImGui::Begin("##probe_badge", nullptr, flags)) {
+        ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + wrap);
+        ImGui::TextColored(ImVec4(0.45f, 0.95f, 0.55f, 1.0f), "%s", text);
+        ImGui::PopTextWrapPos();
+      }
+      ImGui::End();
+    }
   }
 
   if (lab_open_) ui::draw_lab1d_window(lab_, &lab_open_, area_width, area_height);

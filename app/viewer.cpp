@@ -8,12 +8,16 @@
 #include "renderer/film/image_io.h"
 #include "renderer/scene/scene_loader.h"
 #include "renderer/film/film_file.h"
+#include "renderer/hash.h"
 #include "renderer/session/session.h"
 #include "ui/camera_control.h"
 #include "ui/display.h"
+#include "ui/figure_export.h"
 #include "ui/image_view.h"
+#include "ui/layout_report.h"
 #include "ui/measure_panel.h"
 #include "ui/panels.h"
+#include "ui/preferences.h"
 #include "ui/screenshot.h"
 #include "ui/view_texture.h"
 
@@ -25,7 +29,9 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
-#include <imgui_internal.h>  // ClosePopupToLevel: Esc closes a drop-down
+#include <imgui_internal.h>  // ClosePopupToLevel: Esc closes a drop-down; the active text field
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -52,7 +58,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr float kPanelWidth = 400.0f;        // at content scale 1
 constexpr double kFramePeriod = 1.0 / 60.0;  // while something changes on screen
 constexpr double kIdlePeriod = 0.25;         // paused or done: wake on input or now and then
 constexpr const char* kUiFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -83,6 +88,27 @@ std::string default_screenshot_dir() {
   return (ec ? dir : absolute).string();
 }
 
+// A text field is being edited: keys are text then, never shortcuts. Asked
+// after the frame's widgets, so a click that started the edit in this very
+// frame counts (the IO's WantTextInput is the frame before's).
+bool editing_text() {
+  const ImGuiContext& g = *GImGui;
+  return ImGui::GetIO().WantTextInput || (g.ActiveId != 0 && g.ActiveId == g.InputTextState.ID);
+}
+
+// The scene's content hash for a camera moved in the viewer: the scene file's
+// hash and the camera's placement, so a reference of one view (the cache's
+// key, a film's scene) is never taken for another's.
+std::string view_hash(const std::string& scene_hash, const Camera& c) {
+  char text[256];
+  std::snprintf(text, sizeof text, "%s|%.9g %.9g %.9g|%.9g %.9g %.9g|%.9g %.9g %.9g|%.9g", scene_hash.c_str(),
+                static_cast<double>(c.lookfrom.x), static_cast<double>(c.lookfrom.y), static_cast<double>(c.lookfrom.z),
+                static_cast<double>(c.lookat.x), static_cast<double>(c.lookat.y), static_cast<double>(c.lookat.z),
+                static_cast<double>(c.vup.x), static_cast<double>(c.vup.y), static_cast<double>(c.vup.z),
+                static_cast<double>(c.vfov_degrees));
+  return fnv1a_hex(text, std::strlen(text));
+}
+
 double thread_cpu_ms() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -111,6 +137,7 @@ struct Viewer::Impl {
     std::vector<float> history;
     std::uint64_t generation = ~std::uint64_t{0};
     std::uint32_t spp_before = 0;  // in the film from earlier weights
+    double seconds_before = 0.0;   // their rendering time (the film's clock runs on)
   } auto_run;
   bool main_rests_for_reference = false;  // paused while a reference takes every thread
 
@@ -135,11 +162,14 @@ struct Viewer::Impl {
     int key = 0, mods = 0;
   };
   std::vector<KeyPress> keys;  // pressed since the last frame, from the GLFW callback
+  // Keys are acted on after the frame's widgets (see editing_text); until then here.
+  std::vector<KeyPress> pending_keys;
   GLFWkeyfun imgui_key_callback = nullptr;  // ImGui's, which calls ours first
   struct Release {
     int key = 0, scancode = 0, mods = 0;
+    bool seen = false;  // ImGui's NewFrame has seen the key down since
   };
-  std::vector<int> pressed_this_frame;
+  std::vector<int> pressed_this_frame;  // pressed since ImGui's last NewFrame
   std::vector<Release> deferred_releases;
   // Redrawing costs CPU time the render threads could use (and llvmpipe draws
   // on the CPU), so a frame is drawn only when something on it can change.
@@ -177,6 +207,10 @@ struct Viewer::Impl {
   double presentation_since = -1.0;
   float framebuffer_scale = 1.0f;
 
+  // Remembered between runs (ui/preferences.h), when options.remember.
+  std::string preferences_file;
+  std::string layout_written;  // the layout report last written (--layout-json)
+
   FrameReport report;
   int exit_status = 0;
   bool cli_done = false;
@@ -190,6 +224,7 @@ struct Viewer::Impl {
   void open_window(int image_width, int image_height);
   void rebuild_fonts();
   void on_key(int key, int mods);
+  void handle_keys();
   void on_escape();
   void set_presentation(bool on);
   void reset_camera() {
@@ -212,6 +247,12 @@ struct Viewer::Impl {
     settle_frames = 2;
   }
   void fill_status();
+  std::vector<ui::PanelMessage> messages() const;
+  void export_view();
+  void export_curve();
+  void export_convergence();
+  void write_layout_report(int fb_w, int fb_h);
+  void remember_preferences();
   void continue_film(const std::string& path);
   void save_film();
   std::uint32_t film_first_sample = 0;  // of the accumulation shown (0 unless a film was continued)
@@ -231,8 +272,8 @@ struct Viewer::Impl {
   FrameLayout lay_out(int fb_w, int fb_h);
   void draw_panel(const FrameLayout& l, ui::UiRequests& requests);
   void draw_overlays(const FrameLayout& l, ui::UiRequests& requests);
-  ImVec2 badges_corner{0.0f, 0.0f};  // this frame's image badges (draw_panel), kept clear by the legend
   void draw_quit_question();
+  float panel_width_now(float display_width) const;
   void apply_requests(const ui::UiRequests& requests);
   void draw_gl(const FrameLayout& l);
   void record_frame(Clock::time_point t0, double cpu0);
@@ -252,6 +293,20 @@ void Viewer::Impl::open(const ViewerOptions& o) {
     if (options.spp == 0) options.spp = 64;
   }
 
+  if (o.remember && !cli_mode()) {
+    preferences_file = ui::preferences_path();
+    std::string warning;
+    const ui::Preferences p = ui::load_preferences(preferences_file, warning);
+    if (!warning.empty()) std::fprintf(stderr, "note: %s\n", warning.c_str());
+    if (options.window_width <= 0 || options.window_height <= 0) {
+      options.window_width = p.window_width;
+      options.window_height = p.window_height;
+    }
+    settings.panel_width = p.panel_width;
+    settings.panel_hidden = p.panel_hidden;
+    settings.caption = p.caption;
+    panel.open = p.open;
+  }
   settings.sampling = ui::SamplingSettings::from(strategy);
   settings.max_depth = scene.max_depth;
   settings.stop_spp = cli_mode() ? options.spp : o.spp;
@@ -279,7 +334,7 @@ void Viewer::Impl::open(const ViewerOptions& o) {
   so.on_image = [] { glfwPostEmptyEvent(); };
   session = std::make_unique<RenderSession>(so);
   teaching = std::make_unique<TeachingViews>(so.on_image);
-  teaching->set_shared_reference(&measure.reference);
+  teaching->set_shared_reference(measure.matching_reference());
   references = std::make_unique<ViewerReferences>();
   weight_lab = std::make_unique<WeightLab>();
   if (!apply_render_settings()) throw InputError(status.settings_error);
@@ -312,7 +367,8 @@ void Viewer::Impl::continue_film(const std::string& path) {
   rs.first_sample = f.ranges.front().first;
   const auto spp = static_cast<std::uint32_t>(f.spp());
   if (rs.target_spp != 0 && rs.target_spp < spp) rs.target_spp = spp;
-  session->resume(rs, FilmStart{std::move(file.film), spp, f.dropped});
+  // The film's own rendering time and samples go on: its figures describe the whole film.
+  session->resume(rs, FilmStart{std::move(file.film), spp, f.dropped, f.seconds});
   film_first_sample = rs.first_sample;
 }
 
@@ -322,7 +378,8 @@ void Viewer::Impl::save_film() {
   const bool was_paused = settings.paused;
   session->set_paused(true);  // the film is read between two passes
   const RenderSettings rs = session->settings();
-  const double seconds = session->stats().seconds;  // not inside read_film: it holds the session's lock
+  const SessionStats st = session->stats();  // not inside read_film: it holds the session's lock
+  const double seconds = st.seconds;
   try {
     std::error_code ec;
     std::filesystem::create_directories(settings.screenshot_dir, ec);
@@ -348,6 +405,8 @@ void Viewer::Impl::save_film() {
       saved = path;
     });
     notice("Film saved: " + std::filesystem::absolute(saved).string() + " (continue with pdflab --resume)", false);
+    // A saved film keeps the render as a screenshot does: quitting loses nothing then.
+    last_save = {st.generation, seconds};
   } catch (const std::exception& e) {
     notice(std::string("Film not saved: ") + e.what(), true);
   }
@@ -379,7 +438,9 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
     // screens, like everything else), within reason, plus the panel.
     const int image_w = static_cast<int>(static_cast<float>(std::clamp(image_width, 320, 1000)) * scale);
     const int image_h = static_cast<int>(static_cast<float>(std::clamp(image_height, 320, 1000)) * scale);
-    width = image_w + static_cast<int>(kPanelWidth * scale * options.ui_scale);
+    // Wide enough that the panel keeps its width within its share of the window.
+    const float panel_w = std::max(settings.panel_width, ui::kMinPanelWidth) * scale * options.ui_scale;
+    width = std::max(image_w + static_cast<int>(panel_w), static_cast<int>(panel_w / ui::kMaxPanelShare) + 1);
     height = std::max(image_h, static_cast<int>(800.0f * scale));
     if (const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr) {
       width = std::min(width, mode->width * 19 / 20);
@@ -430,6 +491,13 @@ void Viewer::Impl::open_window(int image_width, int image_height) {
   // pressed since the last frame reach ImGui one frame late instead.
   imgui_key_callback = glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int scancode, int action, int mods) {
     Impl& v = *self(w);
+    // Tab hides the panel; ImGui would also move the keyboard focus into the
+    // panel's first text field with it. Inside a text field it stays ImGui's.
+    if (key == GLFW_KEY_TAB && !ImGui::GetIO().WantTextInput) {
+      ++v.input_events;
+      if (action == GLFW_PRESS) v.keys.push_back({key, mods});
+      return;
+    }
     if (action == GLFW_RELEASE &&
         std::find(v.pressed_this_frame.begin(), v.pressed_this_frame.end(), key) != v.pressed_this_frame.end()) {
       v.deferred_releases.push_back({key, scancode, mods});
@@ -490,7 +558,27 @@ void Viewer::Impl::rebuild_fonts() {
   style.ScaleAllSizes(scale() / framebuffer_scale);
 }
 
+void Viewer::Impl::remember_preferences() {
+  if (preferences_file.empty() || !window) return;
+  ui::Preferences p;
+  int w = 0, h = 0;
+  glfwGetWindowSize(window, &w, &h);
+  // The windowed size, not presentation mode's full screen.
+  p.window_width = fullscreen ? windowed_w : w;
+  p.window_height = fullscreen ? windowed_h : h;
+  p.panel_width = settings.panel_width;
+  p.panel_hidden = settings.panel_hidden;
+  p.open = panel.open;
+  p.caption = settings.caption;
+  try {
+    ui::save_preferences(preferences_file, p);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "note: the viewer's settings were not saved: %s\n", e.what());
+  }
+}
+
 void Viewer::Impl::close() {
+  remember_preferences();
   teaching.reset();
   references.reset();  // a reference in the making stops with the viewer
   weight_lab.reset();  // waits for a replay in flight
@@ -541,6 +629,7 @@ bool Viewer::Impl::apply_render_settings() {
       cam.vfov_degrees = camera->vfov_degrees;
     }
     cam.prepare();
+    if (camera && !ui::same_placement(*camera, base_scene->camera)) scene->content_hash = view_hash(base_scene->content_hash, *camera);
     render_scene = std::move(scene);
     render_scene_depth = settings.max_depth;
     render_scene_scale = settings.resolution_scale;
@@ -557,6 +646,7 @@ bool Viewer::Impl::apply_render_settings() {
   rs.strategy = strategy;
   rs.seed = settings.seed;
   rs.target_spp = settings.stop_spp;
+  rs.target_seconds = settings.stop_seconds;
   try {
     session->set_settings(rs);
   } catch (const InputError& e) {
@@ -565,6 +655,14 @@ bool Viewer::Impl::apply_render_settings() {
   }
   status.settings_error.clear();
   applied = settings;
+  // What the figures are measured against from now on must show this.
+  ui::ImageIdentity id;
+  id.view_hash = render_scene->content_hash;
+  id.scene_hash = base_scene->content_hash;
+  id.width = render_scene->camera.width;
+  id.height = render_scene->camera.height;
+  id.max_depth = render_scene->max_depth;
+  measure.set_render_identity(id);
   if (references && references->follow_scene(*render_scene, measure)) after_reference_changed();
   return true;
 }
@@ -665,14 +763,19 @@ void Viewer::Impl::on_key(int key, int mods) {
   }
   if (key == GLFW_KEY_ESCAPE) {
     // A text field being edited takes Esc as "cancel": nothing else happens.
-    if (!ImGui::GetIO().WantTextInput) on_escape();
+    if (!editing_text()) on_escape();
     return;
   }
   if (quit_asking) return;
-  // Typing a path must not pause the render or restart it.
-  if (ImGui::GetIO().WantTextInput && key != GLFW_KEY_F12) return;
+  // Typing a path or a strategy must not pause the render, restart it or
+  // switch views: while a text field is edited, keys are text.
+  if (editing_text() && key != GLFW_KEY_F12) return;
   if (key == GLFW_KEY_S && (mods & GLFW_MOD_CONTROL)) {
     save_film();
+    return;
+  }
+  if (key == GLFW_KEY_E && (mods & GLFW_MOD_CONTROL)) {
+    export_view();
     return;
   }
   if (key == GLFW_KEY_C && (mods & GLFW_MOD_CONTROL)) {
@@ -684,6 +787,10 @@ void Viewer::Impl::on_key(int key, int mods) {
   const double cx = last_area.x + last_area.width * 0.5, cy = last_area.y + last_area.height * 0.5;
   switch (key) {
     case GLFW_KEY_F11: set_presentation(!settings.presentation); return;
+    case GLFW_KEY_TAB:
+      settings.panel_hidden = !settings.panel_hidden;
+      view.fit = true;
+      return;
     case GLFW_KEY_O:
       camera_mode = !camera_mode;
       if (camera_mode) teaching->leave_probe_mode();  // one thing for a left drag to mean
@@ -709,11 +816,9 @@ void Viewer::Impl::on_key(int key, int mods) {
     case GLFW_KEY_1:
     case GLFW_KEY_2:
     case GLFW_KEY_3:
-      settings.sampling = ui::preset_sampling(static_cast<ui::Preset>(key - GLFW_KEY_0));
-      apply_render_settings();
-      break;
     case GLFW_KEY_4:
-      settings.sampling = ui::SamplingSettings::from(Strategy::nee());
+    case GLFW_KEY_5:
+      settings.sampling = ui::preset_by_key(key - GLFW_KEY_0);
       apply_render_settings();
       break;
     case GLFW_KEY_V: settings.measure.view_mode = ui::next_view_mode(settings.measure.view_mode); break;
@@ -810,18 +915,27 @@ void Viewer::Impl::inspect(const ui::ImageRect& image_rect, const ui::ImageRect&
   const auto hit = ui::pixel_at(mx, my, image_rect.x, image_rect.y, image_rect.width, image_rect.height,
                                 image_info.width, image_info.height);
   if (!hit) return;
-  inspected = ui::read_pixel(measure.published, measure.reference.loaded() ? &measure.reference : nullptr, hit->x,
-                             hit->y);
+  // The reference's value only where it shows this render (not another view, size or depth).
+  inspected = ui::read_pixel(measure.published, measure.matching_reference(), hit->x, hit->y);
   if (!inspected) return;
-  ImGui::SetNextWindowPos(ImVec2(area_rect.x + area_rect.width - 8.0f, area_rect.y + area_rect.height - 8.0f),
-                          ImGuiCond_Always, ImVec2(1.0f, 1.0f));
+  const std::string text = inspected->text();
+  ui::layout::Overlay o;
+  o.corner = ui::Corner::BottomRight;
+  o.width = ImGui::CalcTextSize(text.c_str()).x + 2.0f * ImGui::GetStyle().WindowPadding.x;
+  o.height = ui::layout::text_height(static_cast<int>(std::count(text.begin(), text.end(), '\n')) + 2);
+  o.min_width = 10.0f;
+  o.min_lines = 4.0f;
+  float wrap = 0.0f;
+  if (!ui::layout::place_next_window("##inspector", o, &wrap)) return;
   ImGui::SetNextWindowBgAlpha(0.85f);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
   if (ImGui::Begin("##inspector", nullptr, flags)) {
-    ImGui::TextUnformatted(inspected->text().c_str());
-    ImGui::TextColored(ImVec4(0.65f, 0.65f, 0.68f, 1.0f), "Ctrl+C copies. Wheel: zoom,\ndrag: pan, Z: 1:1, F: fit");
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + wrap);
+    ImGui::TextUnformatted(text.c_str());
+    ImGui::TextColored(ImVec4(0.65f, 0.65f, 0.68f, 1.0f), "Ctrl+C copies. Wheel: zoom, drag: pan, Z: 1:1, F: fit");
+    ImGui::PopTextWrapPos();
   }
   ImGui::End();
 }
@@ -853,8 +967,27 @@ ui::ScreenshotData Viewer::Impl::capture() const {
   d.max_depth = applied.max_depth;
   d.version = PDFLAB_VERSION;
   d.generation = image_info.generation;
-  if (render_scene) d.camera = render_scene->camera;
+  if (render_scene) {
+    d.camera = render_scene->camera;
+    d.scene_hash = render_scene->content_hash;
+  }
   d.camera_moved = camera.has_value();
+  // The figures of this very image, and the reference they were measured against (or why not).
+  d.figures = measure.figures;
+  if (measure.reference.loaded()) {
+    const Reference& r = measure.reference;
+    d.reference.loaded = true;
+    d.reference.from_cache = measure.reference_from_cache;
+    d.reference.path = r.path;
+    d.reference.strategy = r.info.strategy;
+    d.reference.scene_hash = measure.reference_identity.view_hash;
+    d.reference.width = r.width;
+    d.reference.height = r.height;
+    d.reference.max_depth = measure.reference_identity.max_depth;
+    d.reference.spp = r.info.spp;
+    d.reference.seconds = r.info.seconds;
+    d.reference.mismatch = measure.reference_mismatch();
+  }
   return d;
 }
 
@@ -931,6 +1064,33 @@ void Viewer::Impl::fill_status() {
   status.split = teaching->split_state();
   status.weights = weight_lab->curve();
   if (auto_run.on) status.weights.history = auto_run.history;
+  status.scale = scale();
+  status.max_depth = applied.max_depth;
+  status.messages = messages();
+  const ui::ViewMode mode = settings.measure.view_mode;
+  status.can_export_view = mode != ui::ViewMode::Image && mode != ui::ViewMode::Drops && measure.layer_ok &&
+                           measure.layer_mode == mode && !teaching->split_active();
+  status.can_export_curve = !status.weights.weight.empty() && status.weights.active;
+  status.can_export_convergence = !measure.curves.live().points.empty() || !measure.curves.pins().empty();
+}
+
+// The panel's message line: errors first, then warnings, then notes, newest
+// first within each; a save's notice is a note for a while.
+std::vector<ui::PanelMessage> Viewer::Impl::messages() const {
+  std::vector<ui::PanelMessage> m;
+  using K = ui::PanelMessage;
+  const bool recent = !status.notice.text.empty() && now() - status.notice.shown_at < 30.0;
+  if (recent && status.notice.error) m.push_back({K::Error, status.notice.text});
+  if (!status.settings_error.empty()) m.push_back({K::Error, status.settings_error});
+  if (!status.scene_error.empty()) m.push_back({K::Error, status.scene_error});
+  if (!measure.reference_error.empty()) m.push_back({K::Error, measure.reference_error});
+  if (measure.figures.valid && !measure.figures.estimate_why.empty()) m.push_back({K::Warning, measure.figures.estimate_why});
+  if (measure.figures.valid && measure.figures.rough_reference)
+    m.push_back({K::Warning, "The reference is rough: its own noise is more than a quarter of the error. Make a better one."});
+  if (!measure.reference_note.empty() && measure.reference_note_warns) m.push_back({K::Warning, measure.reference_note});
+  if (recent && !status.notice.error) m.push_back({K::Note, status.notice.text});
+  if (!measure.reference_note.empty() && !measure.reference_note_warns) m.push_back({K::Note, measure.reference_note});
+  return m;
 }
 
 void Viewer::Impl::load_reference(const std::string& path) {
@@ -961,6 +1121,113 @@ void Viewer::Impl::handle_measure_requests(const ui::MeasureRequests& r) {
   }
   if (r.pin_curve) measure.curves.pin();
   if (r.clear_pins) measure.curves.clear_pins();
+}
+
+namespace {
+
+std::string seconds_text(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, s < 120.0 ? "%.1f s" : "%.0f s", s);
+  return text;
+}
+
+// "Saved a.png (+ b.csv)" with the first path absolute, as the screenshot notice has it.
+std::string saved_text(const std::string& what, const std::vector<std::string>& paths) {
+  std::error_code ec;
+  std::string text = what + " saved: " + fs::absolute(paths.front(), ec).string();
+  for (std::size_t i = 1; i < paths.size(); ++i) text += (i == 1 ? "\n  + " : ", ") + fs::path(paths[i]).filename().string();
+  return text;
+}
+
+}  // namespace
+
+// The false-colour view on screen as a PNG with its legend and a caption
+// (what is shown, of which render, measured how).
+void Viewer::Impl::export_view() {
+  const ui::ViewMode mode = settings.measure.view_mode;
+  if (mode == ui::ViewMode::Image || mode == ui::ViewMode::Drops || !measure.layer_ok || measure.layer_mode != mode) {
+    notice("Nothing to export: V picks a heat map, difference, best-weight or technique-share view to export.", true);
+    return;
+  }
+  ui::FigureCaption caption;
+  const bool metric_view = mode == ui::ViewMode::RelativeError || mode == ui::ViewMode::Difference;
+  caption.title = std::string(mode == ui::ViewMode::RelativeError ? "noise heat map" : ui::view_mode_label(mode)) +
+                  (metric_view ? std::string(": ") + ui::error_metric_label(mode, settings.measure.layer_options(mode).metric)
+                               : std::string());
+  const ui::Figures& f = measure.figures;
+  caption.lines.push_back(base_scene->name + ", " + std::to_string(measure.published.info.width) + "x" +
+                          std::to_string(measure.published.info.height) + (camera ? ", camera moved" : "") +
+                          ", max depth " + std::to_string(applied.max_depth) + ", seed " + std::to_string(applied.seed));
+  caption.lines.push_back(applied.sampling.strategy().to_string());
+  caption.lines.push_back(std::to_string(measure.published.info.spp) + " spp, " +
+                          seconds_text(measure.published.info.seconds) + " of rendering");
+  char line[200];
+  if (f.valid && f.against_reference) {
+    const Reference& r = measure.reference;
+    const std::string against = r.info.spp > 0 ? "a " + std::to_string(r.info.spp) + "-spp reference"
+                                               : "the reference " + fs::path(r.path).filename().string();
+    std::snprintf(line, sizeof line, "relMSE %.4g +- %.2g %s against %s, efficiency %.4g", f.relmse, f.relmse_interval,
+                  f.rough_reference ? "(ROUGH: the reference is noisy)" : "measured", against.c_str(), f.efficiency);
+  }
+  else if (f.valid)
+    std::snprintf(line, sizeof line, "relMSE %.4g estimated from the film's variance (a lower bound)", f.estimated_relmse);
+  else
+    std::snprintf(line, sizeof line, "no figures yet");
+  caption.lines.push_back(line);
+  if (mode == ui::ViewMode::BestWeight || mode == ui::ViewMode::TechniqueShare)
+    caption.lines.push_back("from " + std::to_string(measure.weight_maps.paths) + " paths traced for the prediction, per " +
+                            std::to_string(measure.weight_maps.block) + "x" + std::to_string(measure.weight_maps.block) +
+                            " block");
+  caption.lines.push_back(std::string("pdflab ") + PDFLAB_VERSION);
+  static constexpr const char* kKinds[] = {"image", "heatmap", "difference", "drops", "best-weight", "technique-share"};
+  try {
+    const std::vector<std::uint8_t> png = ui::view_figure_png(mode, measure.layer, caption);
+    const auto paths = ui::save_figure_files(settings.screenshot_dir, kKinds[static_cast<int>(mode)], {{"png", png}},
+                                             std::time(nullptr));
+    notice(saved_text("Figure", paths), false);
+  } catch (const std::exception& e) {
+    notice(std::string("Figure NOT saved: ") + e.what(), true);
+  }
+}
+
+void Viewer::Impl::export_curve() {
+  const ui::WeightCurveStatus& c = weight_lab->curve();
+  const std::array<int, 2> pair = ui::two_technique_pair(applied.sampling, panel.w_pair);
+  if (!c.active || c.weight.empty() || pair[0] < 0) {
+    notice("Nothing to export: the predicted curve shows for a mixture of two techniques once paths are traced.", true);
+    return;
+  }
+  const std::string a(technique_name(static_cast<Technique>(pair[0]))), b(technique_name(static_cast<Technique>(pair[1])));
+  char title[200];
+  std::snprintf(title, sizeof title, "Predicted efficiency against w, %s, %u spp (%llu paths)", base_scene->name.c_str(),
+                image_info.spp, static_cast<unsigned long long>(c.paths));
+  const std::string svg = ui::weight_curve_svg(c, a, b, title), csv = ui::weight_curve_csv(c);
+  try {
+    const auto paths = ui::save_figure_files(settings.screenshot_dir, "curve",
+                                             {{"svg", {svg.begin(), svg.end()}}, {"csv", {csv.begin(), csv.end()}}},
+                                             std::time(nullptr));
+    notice(saved_text("Curve", paths), false);
+  } catch (const std::exception& e) {
+    notice(std::string("Curve NOT saved: ") + e.what(), true);
+  }
+}
+
+void Viewer::Impl::export_convergence() {
+  if (measure.curves.live().points.empty() && measure.curves.pins().empty()) {
+    notice("Nothing to export: the convergence plot has no points yet.", true);
+    return;
+  }
+  const std::string title = "Convergence, " + base_scene->name;
+  const std::string svg = ui::convergence_svg(measure.curves, settings.measure.plot_against_spp, title);
+  const std::string csv = ui::convergence_csv(measure.curves);
+  try {
+    const auto paths = ui::save_figure_files(settings.screenshot_dir, "convergence",
+                                             {{"svg", {svg.begin(), svg.end()}}, {"csv", {csv.begin(), csv.end()}}},
+                                             std::time(nullptr));
+    notice(saved_text("Convergence plot", paths), false);
+  } catch (const std::exception& e) {
+    notice(std::string("Convergence plot NOT saved: ") + e.what(), true);
+  }
 }
 
 Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -995,6 +1262,7 @@ void Viewer::Impl::service_weights() {
   in.strategy = applied.sampling.strategy();
   in.seed = applied.seed;
   in.spp_before = auto_run.on ? auto_run.spp_before : 0;
+  in.seconds_before = auto_run.on ? auto_run.seconds_before : 0.0;
   in.first_sample = film_first_sample + in.spp_before;
   in.generation = session->generation();
   in.a = mixture ? pair[0] : -1;
@@ -1051,28 +1319,41 @@ void Viewer::Impl::service_auto_weight() {
   settings.sampling.weights[b] = static_cast<float>(1.0 - w);
   rs.strategy = settings.sampling.strategy();
   try {
-    session->resume(rs, FilmStart{std::move(film), st.spp, st.dropped});
+    session->resume(rs, FilmStart{std::move(film), st.spp, st.dropped, st.seconds});
   } catch (const InputError& e) {
     status.settings_error = e.what();
   }
   session->set_paused(settings.paused || main_rests_for_reference);
   applied.sampling = settings.sampling;
   auto_run.spp_before = st.spp;
+  auto_run.seconds_before = st.seconds;
   auto_run.generation = session->generation();
 }
 
 void Viewer::Impl::handle_input() {
-  // Last frame's quick releases first (see open_window), then the new events.
-  pressed_this_frame.clear();
-  for (const Release& r : std::exchange(deferred_releases, {}))
-    if (imgui_key_callback) imgui_key_callback(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+  // Quick releases whose press a frame has seen first (see open_window), then
+  // the new events. A press and release both taken while the last frame waited
+  // (pace) are not seen yet: replayed now, ImGui would never see the key down.
+  std::vector<Release> unseen;
+  for (const Release& r : std::exchange(deferred_releases, {})) {
+    if (!r.seen) unseen.push_back(r);
+    else if (imgui_key_callback) imgui_key_callback(window, r.key, r.scancode, GLFW_RELEASE, r.mods);
+  }
+  deferred_releases = std::move(unseen);
   glfwPollEvents();
-  for (const KeyPress& k : keys) on_key(k.key, k.mods);
+  pending_keys.insert(pending_keys.end(), keys.begin(), keys.end());
   keys.clear();
+}
+
+// The keys of this frame, after its widgets: whether a text field took them is known then.
+void Viewer::Impl::handle_keys() {
+  for (const KeyPress& k : std::exchange(pending_keys, {})) on_key(k.key, k.mods);
 }
 
 void Viewer::Impl::service_background() {
   pull_image();
+  // The split measures against the Measure section's reference only where it shows this render.
+  teaching->set_shared_reference(measure.matching_reference());
   service_auto_weight();
   service_weights();
   service_references();
@@ -1101,12 +1382,17 @@ void Viewer::Impl::upload_textures() {
     view_texture->upload(measure.layer.rgba.data(), measure.layer.width, measure.layer.height);
 }
 
+float Viewer::Impl::panel_width_now(float display_width) const {
+  if (settings.presentation || settings.panel_hidden) return 0.0f;
+  return ui::panel_width_for(settings.panel_width, scale() / framebuffer_scale, display_width);
+}
+
 Viewer::Impl::FrameLayout Viewer::Impl::lay_out(int fb_w, int fb_h) {
   const ImGuiIO& io = ImGui::GetIO();
   FrameLayout l;
   l.fb_w = fb_w;
   l.fb_h = fb_h;
-  l.panel_width = settings.presentation ? 0.0f : std::min(kPanelWidth * scale() / framebuffer_scale, io.DisplaySize.x);
+  l.panel_width = panel_width_now(io.DisplaySize.x);
   const float fbs = framebuffer_scale;
   l.panel_px = static_cast<int>(l.panel_width * fbs);
   l.area = {0, 0, std::max(0, fb_w - l.panel_px), fb_h};
@@ -1116,29 +1402,37 @@ Viewer::Impl::FrameLayout Viewer::Impl::lay_out(int fb_w, int fb_h) {
                   static_cast<float>(fb_h - l.image_fb.y - l.image_fb.height) / fbs,
                   static_cast<float>(l.image_fb.width) / fbs, static_cast<float>(l.image_fb.height) / fbs};
   l.area_rect = {0.0f, 0.0f, io.DisplaySize.x - l.panel_width, io.DisplaySize.y};
+  // The overlays of this frame go around the image's middle (ui/layout_report).
+  ui::layout::begin_frame({l.area_rect.x, l.area_rect.y, l.area_rect.width, l.area_rect.height},
+                          {l.image_rect.x, l.image_rect.y, l.image_rect.width, l.image_rect.height}, ImGui::GetFontSize());
   return l;
 }
 
 void Viewer::Impl::draw_panel(const FrameLayout& l, ui::UiRequests& requests) {
   const ImGuiIO& io = ImGui::GetIO();
-  badges_corner = ImVec2(0.0f, 0.0f);
   if (!settings.presentation) {
-    ui::draw_side_panel(l.panel_width, io.DisplaySize.y, settings, panel, status, requests);
-    badges_corner = ui::draw_image_badges(settings, status);
+    if (l.panel_width > 0.0f) {
+      const ui::Box box{io.DisplaySize.x - l.panel_width, 0.0f, l.panel_width, io.DisplaySize.y};
+      ui::draw_side_panel(box, settings, panel, status, requests);
+      ui::draw_panel_edge(box, scale() / framebuffer_scale, io.DisplaySize.x, settings);
+    } else {
+      ui::draw_panel_tab(requests);
+    }
+    ui::draw_image_badges(settings, status);
   } else if (now() - presentation_since < 3.0) {
     ui::draw_hint("Presentation mode: F11 or Esc leaves");
   }
   if (camera_mode) ui::draw_hint("Camera: drag orbits, right-drag pans, wheel dollies; Home resets, O or Esc leaves");
+  if (settings.presentation && settings.caption) ui::draw_caption(settings, status);
   ui::draw_help_overlay(panel, io.DisplaySize.x - l.panel_width, io.DisplaySize.y);
-  if (!status.notice.text.empty() && now() - status.notice.shown_at < 6.0)
-    ui::draw_notice_toast(status.notice, l.area_rect.width, l.area_rect.height);
+  if (!status.notice.text.empty() && now() - status.notice.shown_at < 6.0) ui::draw_notice_toast(status.notice);
 }
 
 void Viewer::Impl::draw_overlays(const FrameLayout& l, ui::UiRequests& requests) {
   // Layers, the divider, the probe's cross: never over the panel, however far the image reaches.
   const ui::ImageRect& a = l.area_rect;
   ImGui::GetBackgroundDrawList()->PushClipRect(ImVec2(a.x, a.y), ImVec2(a.x + a.width, a.y + a.height));
-  ui::draw_image_overlays(l.image_rect, a, settings, measure, view_texture->id(), requests, badges_corner);
+  if (!teaching->split_active()) ui::draw_image_overlays(l.image_rect, settings, measure, view_texture->id(), requests);
   teaching->draw_ui(*session, l.image_fb, l.fb_h, framebuffer_scale, a.width, a.height);
   if (!settings.presentation) inspect(l.image_rect, a);
   else inspected.reset();
@@ -1146,8 +1440,7 @@ void Viewer::Impl::draw_overlays(const FrameLayout& l, ui::UiRequests& requests)
 }
 
 void Viewer::Impl::draw_quit_question() {
-  if (!quit_asking) return;
-  switch (ui::draw_quit_dialog(unsaved_seconds(), quit_after_save || save_job.valid(), status.notice)) {
+  switch (ui::draw_quit_dialog(quit_asking, unsaved_seconds(), quit_after_save || save_job.valid(), status.notice)) {
     case ui::QuitChoice::SaveAndQuit:
       quit_after_save = true;
       screenshot_wanted = true;
@@ -1166,7 +1459,17 @@ void Viewer::Impl::apply_requests(const ui::UiRequests& requests) {
   if (requests.pause_changed) session->set_paused(settings.paused);
   if (requests.stop_changed) {
     session->set_target_spp(settings.stop_spp);
+    session->set_target_seconds(settings.stop_seconds);
     applied.stop_spp = settings.stop_spp;
+    applied.stop_seconds = settings.stop_seconds;
+  }
+  if (requests.save_film) save_film();
+  if (requests.export_view) export_view();
+  if (requests.export_curve) export_curve();
+  if (requests.export_convergence) export_convergence();
+  if (requests.toggle_panel) {
+    settings.panel_hidden = !settings.panel_hidden;
+    view.fit = true;
   }
   if (requests.screenshot) screenshot_wanted = true;
   if (requests.toggle_presentation) set_presentation(!settings.presentation);
@@ -1180,6 +1483,38 @@ void Viewer::Impl::apply_requests(const ui::UiRequests& requests) {
     ui::ScreenshotData data = std::move(*failed_save);
     failed_save.reset();
     start_save(std::move(data));
+  }
+}
+
+// --layout-json: the frame's layout, written when it changed (to a temporary
+// name, then renamed, so a reader never sees half a file).
+void Viewer::Impl::write_layout_report(int fb_w, int fb_h) {
+  if (options.layout_json.empty()) return;
+  (void)fb_w;
+  (void)fb_h;
+  int ww = 0, wh = 0;
+  glfwGetWindowSize(window, &ww, &wh);
+  const ui::Figures& f = measure.figures;
+  nlohmann::json extra;
+  extra["panel_hidden"] = settings.panel_hidden;
+  extra["presentation"] = settings.presentation;
+  extra["split"] = teaching->split_active();
+  extra["quit_asking"] = quit_asking;
+  extra["view"] = ui::view_mode_label(settings.measure.view_mode);
+  extra["done"] = status.stats.done;
+  extra["figures"] = {{"source", !f.valid ? "none" : (f.against_reference ? (f.rough_reference ? "rough" : "measured") : "estimated")},
+                      {"why_estimated", f.estimate_why},
+                      {"estimate_unreliable", f.estimate_unreliable},
+                      {"spp", f.spp}};
+  extra["messages"] = nlohmann::json::array();
+  for (const ui::PanelMessage& m : status.messages) extra["messages"].push_back(m.text);
+  const std::string text = ui::layout::report_json(ww, wh, settings.ui_scale, extra.dump());
+  if (text == layout_written) return;
+  try {
+    write_file_atomic(options.layout_json, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    layout_written = text;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pdflab: layout report not written: %s\n", e.what());
   }
 }
 
@@ -1252,6 +1587,9 @@ bool Viewer::frame(bool paced, bool force_draw) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
+  // The keys down now have been seen: their releases may follow next frame.
+  v.pressed_this_frame.clear();
+  for (Impl::Release& r : v.deferred_releases) r.seen = true;
   if (v.close_popups) ImGui::ClosePopupToLevel(0, true);
   v.close_popups = false;
   v.fill_status();
@@ -1260,7 +1598,9 @@ bool Viewer::frame(bool paced, bool force_draw) {
   v.draw_panel(layout, requests);
   v.draw_overlays(layout, requests);
   v.draw_quit_question();
+  v.handle_keys();
   ImGui::Render();
+  v.write_layout_report(fb_w, fb_h);
 
   v.apply_requests(requests);
   v.draw_gl(layout);

@@ -14,8 +14,14 @@ struct ViewerOptions {
   std::string strategy = "mix:cosine=0.5,light=0.5";
   std::uint32_t spp = 0;   // with `screenshot`: render this many samples per pixel, save, exit
   std::string screenshot;  // PNG path; the PFM and JSON go beside it
-  // Window size in screen coordinates (0: fit the image and the panel).
+  // Window size in screen coordinates (0: as remembered, else fit the image and the panel).
   int window_width = 0, window_height = 0;
+  // Remember the window's size, the panel's width and open sections between
+  // runs (ui/preferences.h); off for benchmarks and tests that drive a Viewer.
+  bool remember = false;
+  // Write the layout (ui/layout_report.h) to this JSON file after each frame
+  // whose layout changed (empty: not at all).
+  std::string layout_json;
   std::string reference;  // PFM to measure the error against (empty: none)
   float ui_scale = 1.0f;  // panels and text, times the screen's own scale (0.5..4)
   bool presentation = false;  // start full screen without the panel

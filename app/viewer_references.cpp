@@ -22,6 +22,7 @@ ViewerReferences::~ViewerReferences() {
 }
 
 bool ViewerReferences::follow_scene(const Scene& render_scene, ui::MeasureState& m) {
+  // The scene (its view), size and depth: the reference cache's key.
   const ReferenceKey key = reference_key(render_scene);
   if (key.stem() == looked_up_) return false;
   looked_up_ = key.stem();
@@ -40,13 +41,10 @@ bool ViewerReferences::follow_scene(const Scene& render_scene, ui::MeasureState&
     m.reference_error = found.message + "; Make reference rebuilds it.";
     std::fprintf(stderr, "note: %s\n", found.message.c_str());
   }
-  if (m.reference.loaded() && m.reference_from_cache) {
-    // Of another scene, size or depth: it would measure nothing.
-    m.set_reference({});
-    m.reference_from_cache = false;
-    m.reference_note = "No cached reference for this scene, size and depth.";
-    return true;
-  }
+  // A reference from the cache of another view, size or depth stays loaded:
+  // the figures say they are estimates and why (MeasureState::reference_mismatch),
+  // and going back (Home, the old size) measures against it again.
+  if (!m.reference.loaded()) m.reference_note.clear();
   return false;
 }
 
@@ -65,7 +63,8 @@ void ViewerReferences::start(const Scene& render_scene, const std::string& scene
   job.scene = scene;
   job.scene_file = scene_file;
   job.strategy = default_reference_strategy(*scene);
-  job.goal.seconds = std::clamp(static_cast<double>(s.make_seconds), 1.0, 3600.0);
+  std::string target;
+  job.goal = ui::reference_goal(s, m.figures, target);
   job.threads = threads;
   job.background_priority = true;
   job.version = PDFLAB_VERSION;
@@ -84,6 +83,8 @@ void ViewerReferences::start(const Scene& render_scene, const std::string& scene
   m.build.width = scene->camera.width;
   m.build.height = scene->camera.height;
   m.build.threads = threads;
+  m.build.target = target;
+  m.build.max_seconds = job.goal.max_seconds;
 }
 
 void ViewerReferences::cancel(ui::MeasureState& m) {
@@ -102,13 +103,18 @@ bool ViewerReferences::service(ui::MeasureState& m) {
     m.build.spp = st.spp;
     if (p.reached) {
       m.build.finishing = true;
-      // finish() waits for the pass in flight and the files take a moment: off the UI thread.
+      // finish() waits for the pass in flight and the files take a moment: off
+      // the UI thread. One stopped by the time limit short of its target stays
+      // out of the cache, where later runs would take it for a finished one.
       storing_ = std::async(std::launch::async, [build = build_.get(), dir = cache_dir_, key = build_key_] {
         Stored out;
         try {
           out.reference = build->finish();
-          out.path = store_cached_reference(dir, key, out.reference);
-          out.reference.path = out.path;
+          out.capped = build->capped();
+          if (!out.capped) {
+            out.path = store_cached_reference(dir, key, out.reference);
+            out.reference.path = out.path;
+          }
         } catch (const std::exception& e) {
           out.error = e.what();
         }
@@ -126,14 +132,25 @@ bool ViewerReferences::service(ui::MeasureState& m) {
   }
   const ReferenceInfo info = done.reference.info;
   const int w = done.reference.width, h = done.reference.height;
+  if (done.capped) done.reference.path = "made in the viewer (not cached)";
   m.set_reference(std::move(done.reference));
-  m.reference_from_cache = true;
+  m.reference_from_cache = !done.capped;
   looked_up_ = build_key_.stem();
-  char note[256];
-  std::snprintf(note, sizeof note, "Made a reference: %dx%d, %u spp of %s in %.0f s, stored in the cache.", w, h,
-                info.spp, info.strategy.c_str(), info.seconds);
+  char note[320];
+  if (done.capped) {
+    std::snprintf(note, sizeof note,
+                  "The reference stopped at its %.0f s limit short of its target: %dx%d, %u spp of %s. Kept for this "
+                  "session, not cached.",
+                  info.seconds, w, h, info.spp, info.strategy.c_str());
+    std::fprintf(stderr, "note: made a reference short of its target (%u spp in %.0f s), not cached\n", info.spp,
+                 info.seconds);
+  } else {
+    std::snprintf(note, sizeof note, "Made a reference: %dx%d, %u spp of %s in %.0f s, stored in the cache.", w, h,
+                  info.spp, info.strategy.c_str(), info.seconds);
+    std::fprintf(stderr, "note: made a reference, stored as %s\n", done.path.c_str());
+  }
   m.reference_note = note;
-  std::fprintf(stderr, "note: made a reference, stored as %s\n", done.path.c_str());
+  m.reference_note_warns = done.capped;
   return true;
 }
 

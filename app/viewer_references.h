@@ -27,8 +27,10 @@ class ViewerReferences {
   // came from the cache (or none); one loaded by hand stays. Returns true when
   // the reference changed.
   bool follow_scene(const Scene& render_scene, ui::MeasureState& m);
-  // Starts a build of `render_scene` at 1/divisor of its size. Replaces nothing
-  // until it is done; a second start while one runs is ignored.
+  // Starts a build of `render_scene` at 1/divisor of its size, to the target
+  // `s` names (a share of the figures now shown, or an spp) within its time
+  // limit. Replaces nothing until it is done; a second start while one runs is
+  // ignored.
   void start(const Scene& render_scene, const std::string& scene_file, const ui::MeasureSettings& s,
              ui::MeasureState& m);
   void cancel(ui::MeasureState& m);
@@ -44,6 +46,7 @@ class ViewerReferences {
   struct Stored {
     Reference reference;
     std::string path, error;
+    bool capped = false;  // short of its target: not cached
   };
   std::string cache_dir_;
   std::string looked_up_;  // the key's stem last looked up

@@ -189,9 +189,9 @@ bool WeightLab::update(const Input& in) {
   round->predictor = std::move(predictor_);
   round->share = std::move(share_);
   round->mean = in.image->rgb;
-  // This generation's time over its own samples (auto weight's earlier
-  // passes are in the film's spp, not in the generation's seconds).
-  round->seconds_per_pass = info->seconds / drawn;
+  // This weight's time over its own samples (auto weight's earlier passes
+  // are in the film's spp and in its clock, which runs on across them).
+  round->seconds_per_pass = std::max(0.0, info->seconds - in.seconds_before) / drawn;
   traced_ += kRoundSpp;
   job_generation_ = generation_;
   job_ = std::async(std::launch::async, [round] { return run_round(*round); });

@@ -41,6 +41,7 @@ class WeightLab {
     std::uint64_t seed = 0;
     std::uint32_t first_sample = 0;  // the first sample index drawn at this strategy
     std::uint32_t spp_before = 0;    // samples per pixel in the film from before it (auto weight's earlier passes)
+    double seconds_before = 0.0;     // and the rendering time they took (the film's clock runs on)
     std::uint64_t generation = 0;
     int a = -1, b = -1;  // the w slider's techniques (indices); -1: no pair
     const PublishedImage* image = nullptr;  // the latest published pass

@@ -4,10 +4,17 @@
 
 namespace pdflab::ui {
 
+std::string curve_label(const Curve& c) {
+  std::string s = c.label.empty() ? std::string("-") : c.label;
+  if (c.width > 0 && c.height > 0) s += ", " + std::to_string(c.width) + "x" + std::to_string(c.height);
+  if (c.estimated) s += " (est.)";
+  return s;
+}
+
 bool ConvergenceRecorder::record(std::uint64_t generation, const std::string& label, bool estimated,
-                                 std::uint32_t spp, double seconds, double error) {
+                                 std::uint32_t spp, double seconds, double error, int width, int height) {
   if (!started_ || generation != generation_ || label != live_.label || estimated != live_.estimated) {
-    live_ = Curve{label, estimated, {}};
+    live_ = Curve{label, estimated, {}, width, height};
     generation_ = generation;
     started_ = true;
   }

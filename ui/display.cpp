@@ -21,51 +21,11 @@ Viewport fit_image(const Viewport& area, int image_width, int image_height) {
   return v;
 }
 
-namespace {
-
-GLuint compile(GLenum kind, const char* source, std::string& error) {
-  const GLuint shader = glCreateShader(kind);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    error = std::string(kind == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader: " + log;
-    glDeleteShader(shader);
-    return 0;
-  }
-  return shader;
-}
-
-}  // namespace
-
 bool ImageDisplay::init(std::string& error) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, shaders::display_vert, error);
-  if (!vs) return false;
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, shaders::display_frag, error);
-  if (!fs) {
-    glDeleteShader(vs);
-    return false;
-  }
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-    error = std::string("shader link: ") + log;
-    return false;
-  }
-  exposure_location_ = glGetUniformLocation(program_, "exposure");
-  transfer_location_ = glGetUniformLocation(program_, "transfer");
-  sampler_location_ = glGetUniformLocation(program_, "mean_radiance");
+  if (!program_.build(shaders::display_vert, shaders::display_frag, error)) return false;
+  exposure_location_ = program_.uniform("exposure");
+  transfer_location_ = program_.uniform("transfer");
+  sampler_location_ = program_.uniform("mean_radiance");
 
   glGenVertexArrays(1, &vao_);
   glGenTextures(1, &texture_);
@@ -87,7 +47,6 @@ ImageDisplay::~ImageDisplay() {
   if (mapped_texture_) glDeleteTextures(1, &mapped_texture_);
   if (texture_) glDeleteTextures(1, &texture_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
-  if (program_) glDeleteProgram(program_);
 }
 
 void ImageDisplay::upload(const float* rgb, int width, int height) {
@@ -112,7 +71,7 @@ void ImageDisplay::tone_map(float exposure_ev, bool srgb) {
   glBindFramebuffer(GL_FRAMEBUFFER, mapped_fbo_);
   glViewport(0, 0, width_, height_);
   glDisable(GL_BLEND);
-  glUseProgram(program_);
+  glUseProgram(program_.id());
   glUniform1f(exposure_location_, std::exp2(exposure_ev));
   glUniform1i(transfer_location_, srgb ? 1 : 0);
   glUniform1i(sampler_location_, 0);

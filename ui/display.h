@@ -1,6 +1,8 @@
 #pragma once
 // Shows the mean radiance as a float texture through shaders/display.*.
 // Needs a current OpenGL 3.3 core context with glad loaded.
+#include "ui/gl_program.h"
+
 #include <cstdint>
 #include <string>
 
@@ -34,7 +36,8 @@ class ImageDisplay {
  private:
   void tone_map(float exposure_ev, bool srgb);
 
-  std::uint32_t program_ = 0, vao_ = 0, texture_ = 0;
+  GlProgram program_;
+  std::uint32_t vao_ = 0, texture_ = 0;
   std::uint32_t mapped_texture_ = 0, mapped_fbo_ = 0;  // tone-mapped RGBA8 copy
   bool mapped_stale_ = true;
   float mapped_exposure_ = 0.0f;

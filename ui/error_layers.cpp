@@ -79,7 +79,7 @@ ViewRange sanitized(const ViewRange& range, bool signed_metric) {
   if (!usable(r.hi)) r.hi = r.lo * 1e3;
   if (r.lo > r.hi) std::swap(r.lo, r.hi);
   r.lo = std::max(r.lo, 1e-30);
-  if (!(r.hi > r.lo * (1.0 + 1e-6))) r.hi = r.lo * 10.0;
+  if (!(r.hi >= r.lo * kMinRangeRatio)) r.hi = r.lo * kMinRangeRatio;
   return r;
 }
 

@@ -37,7 +37,9 @@ struct ViewRange {
   double lo = 1e-3, hi = 10.0;
   bool operator==(const ViewRange&) const = default;
 };
-// A usable range: positive, lo below hi, finite (a typed 0 or a swapped pair is fixed).
+// A usable range: positive, finite, hi at least kMinRangeRatio times lo (a
+// typed 0, a swapped pair or two equal ends is fixed).
+inline constexpr double kMinRangeRatio = 1.05;
 ViewRange sanitized(const ViewRange& range, bool signed_metric);
 struct LayerOptions {
   ErrorMetric metric = ErrorMetric::Relative;

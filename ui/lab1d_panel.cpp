@@ -236,12 +236,19 @@ void pi_plot(Lab1dState& s, ImVec2 size) {
 }  // namespace
 
 void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_height) {
-  // The lab is about no image: it may cover the side panel too.
+  // The lab is about no image: it may cover the side panel too. Its size
+  // follows the window and the UI scale (fonts 64 wide by 48 high at most):
+  // set when it opens and whenever the window or the scale changes.
+  (void)area_width;
+  (void)area_height;
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  const float w = std::min(std::max(area_width, display.x) - 20.0f, 960.0f);
-  const float h = std::min(std::max(area_height, display.y) - 20.0f, 740.0f);
-  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_Appearing);
-  ImGui::SetNextWindowSize(ImVec2(std::max(w, 300.0f), std::max(h, 300.0f)), ImGuiCond_Appearing);
+  const float font = ImGui::GetFontSize();
+  const float w = std::max(300.0f, std::min(display.x - 20.0f, font * 64.0f));
+  const float h = std::max(300.0f, std::min(display.y - 20.0f, font * 48.0f));
+  const bool resized = s.sized_for[0] != display.x || s.sized_for[1] != display.y || s.sized_for[2] != font;
+  s.sized_for = {display.x, display.y, font};
+  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
+  ImGui::SetNextWindowSize(ImVec2(w, h), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
   ImGui::SetNextWindowBgAlpha(0.97f);
   if (!ImGui::Begin("1D lab: Monte Carlo on [0, 2] (L)", open, ImGuiWindowFlags_NoSavedSettings)) {
     ImGui::End();
@@ -299,9 +306,15 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
 
   if (!s.f_error.empty()) ImGui::TextColored(kRed, "%s", s.f_error.c_str());
   const double exact = s.exact();
-  ImGui::Text("N = %llu   estimate %.5f +- %.5f   exact %.5f%s   error %+.2e",
-              static_cast<unsigned long long>(s.count()), s.estimator.mean(), s.estimator.standard_error(), exact,
-              s.typed ? " (adaptive quadrature)" : "", s.estimator.mean() - exact);
+  // An integral that diverges (1/x from 0) has no exact value to show, nor an error.
+  char exact_text[96];
+  if (std::isfinite(exact))
+    std::snprintf(exact_text, sizeof exact_text, "exact %.5f%s   error %+.2e", exact, s.typed ? " (adaptive quadrature)" : "",
+                  s.estimator.mean() - exact);
+  else
+    std::snprintf(exact_text, sizeof exact_text, "exact: none, the integral diverges");
+  ImGui::TextWrapped("N = %llu   estimate %.5f +- %.5f   %s", static_cast<unsigned long long>(s.count()),
+                     s.estimator.mean(), s.estimator.standard_error(), exact_text);
   if (s.typed) {
     ImGui::TextColored(kDim, "A typed f: whether f/p has a finite variance is for the error plot to show.");
   } else if (!lab::has_finite_variance(s.integrand, s.pdf)) {
@@ -317,7 +330,7 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
 
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const float gap = ImGui::GetStyle().ItemSpacing.x;
-  const ImVec2 cell((avail.x - gap) * 0.5f, std::max(140.0f, (avail.y - ImGui::GetStyle().ItemSpacing.y) * 0.5f));
+  const ImVec2 cell((avail.x - gap) * 0.5f, std::max(font * 9.0f, (avail.y - ImGui::GetStyle().ItemSpacing.y) * 0.5f));
   curves_plot(s, cell);
   ImGui::SameLine();
   histogram_plot(s, cell);

@@ -5,6 +5,7 @@
 #include "renderer/lab/expression.h"
 #include "renderer/lab/lab1d.h"
 
+#include <array>
 #include <cstdint>
 #include <future>
 #include <optional>
@@ -39,6 +40,7 @@ struct Lab1dState {
   std::vector<LabHistoryPoint> history;
   std::uint64_t seed = 1;
   bool running = true;
+  std::array<float, 3> sized_for{};  // the window's size and font size the lab's window was last sized for
   int samples_per_frame = 64;
   std::uint64_t max_samples = 1u << 20;
 

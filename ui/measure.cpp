@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace pdflab::ui {
 
@@ -34,9 +35,67 @@ Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, co
     f.relmse_raw = m.raw;
     f.reference_share = m.reference_share();
     f.reference_corrected = m.reference_corrected;
+    f.rough_reference = m.reference_corrected && f.reference_share > kRoughShare;
     f.efficiency = efficiency(f.relmse, f.seconds);
   }
   return f;
+}
+
+ImageIdentity identity_of(const ReferenceImage& reference) {
+  ImageIdentity id;
+  id.width = reference.width;
+  id.height = reference.height;
+  const ReferenceInfo& info = reference.info;
+  // A film of a scene without a content hash records zeros: unknown.
+  if (info.has_sidecar && !info.scene_hash.empty() && info.scene_hash.find_first_not_of('0') != std::string::npos)
+    id.view_hash = info.scene_hash;
+  if (info.has_sidecar) id.max_depth = info.max_depth;
+  id.assumed = id.view_hash.empty();
+  return id;
+}
+
+std::string identity_mismatch(const ImageIdentity& ref, const ImageIdentity& render) {
+  char text[200];
+  if (ref.width > 0 && render.width > 0 && (ref.width != render.width || ref.height != render.height)) {
+    std::snprintf(text, sizeof text, "The reference is %dx%d, the render %dx%d: the figures are estimates.", ref.width,
+                  ref.height, render.width, render.height);
+    return text;
+  }
+  if (!ref.view_hash.empty() && !render.view_hash.empty() && ref.view_hash != render.view_hash) {
+    const bool same_scene = ref.view_hash == render.scene_hash ||
+                            (!ref.scene_hash.empty() && ref.scene_hash == render.scene_hash);
+    if (same_scene)
+      return render.view_hash != render.scene_hash
+                 ? "The camera moved away from the reference's view (Home goes back): the figures are estimates."
+                 : "The reference shows another view of this scene: the figures are estimates.";
+    return "The reference is of another scene: the figures are estimates.";
+  }
+  if (ref.max_depth > 0 && render.max_depth > 0 && ref.max_depth != render.max_depth) {
+    std::snprintf(text, sizeof text, "The reference has max depth %d, the render %d: the figures are estimates.",
+                  ref.max_depth, render.max_depth);
+    return text;
+  }
+  return {};
+}
+
+ReferenceGoal reference_goal(const MeasureSettings& s, const Figures& now, std::string& note) {
+  ReferenceGoal goal;
+  goal.max_seconds = std::clamp(static_cast<double>(s.make_seconds), 1.0, 3600.0);
+  if (s.make_target == ReferenceTarget::Share && now.valid && now.estimated_relmse > 0.0) {
+    // The reference's noise is about its own relMSE over the raw error's sum of
+    // both: at most kTargetShare of it when its relMSE is share / (1 - share)
+    // of the render's.
+    goal.relmse = now.estimated_relmse * kTargetShare / (1.0 - kTargetShare);
+    char text[160];
+    std::snprintf(text, sizeof text, "target: relMSE %.3g, %.0f%% of the render's %.3g at %u spp", goal.relmse,
+                  100.0 * kTargetShare, now.estimated_relmse, now.spp);
+    note = text;
+    return goal;
+  }
+  goal.spp = std::max<std::uint32_t>(1, s.make_spp);
+  note = "target: " + std::to_string(goal.spp) + " spp";
+  if (s.make_target == ReferenceTarget::Share) note += " (no figures yet to aim the share at)";
+  return goal;
 }
 
 namespace {
@@ -60,11 +119,12 @@ void MeasureState::on_image(std::uint64_t current_generation, const std::string&
     }
     history.add(published.info.spp, published.info.estimated_relmse);
   }
-  figures = compute_figures(published.info, published.rgb, &reference, unbiased);
-  figures.estimate_unreliable = history.unreliable();
+  figures = compute_figures(published.info, published.rgb, matching_reference(), unbiased);
+  figures.estimate_why = reference.loaded() ? reference_mismatch() : std::string();
+  figures.estimate_unreliable = history.unreliable_now();
   if (figures.valid && published.info.generation == current_generation)
     curves.record(published.info.generation, label, !figures.against_reference, figures.spp, figures.seconds,
-                  figures.plot_error());
+                  figures.plot_error(), published.info.width, published.info.height);
   layer_ok = false;
   layer_why.clear();
 }
@@ -72,11 +132,43 @@ void MeasureState::on_image(std::uint64_t current_generation, const std::string&
 void MeasureState::set_reference(ReferenceImage image) {
   reference = std::move(image);
   reference_error.clear();
+  reference_note_warns = false;
+  reference_identity = reference_identity_of_loaded();
   const bool unbiased = figures.unbiased;
-  figures = compute_figures(published.info, published.rgb, &reference, unbiased);
-  figures.estimate_unreliable = history.unreliable();
+  figures = compute_figures(published.info, published.rgb, matching_reference(), unbiased);
+  figures.estimate_why = reference.loaded() ? reference_mismatch() : std::string();
+  figures.estimate_unreliable = history.unreliable_now();
   layer_ok = false;
   layer_why.clear();
+}
+
+ImageIdentity MeasureState::reference_identity_of_loaded() const {
+  ImageIdentity id = identity_of(reference);
+  if (id.assumed && !render_identity.view_hash.empty()) {
+    // Without a sidecar: the render as it is now, at the reference's own size.
+    id.view_hash = render_identity.view_hash;
+    id.scene_hash = render_identity.scene_hash;
+    id.max_depth = render_identity.max_depth;
+  }
+  return id;
+}
+
+void MeasureState::set_render_identity(const ImageIdentity& identity) {
+  render_identity = identity;
+  if (reference.loaded() && reference_identity.assumed && reference_identity.view_hash.empty())
+    reference_identity = reference_identity_of_loaded();
+  layer_ok = false;
+  layer_why.clear();
+}
+
+std::string MeasureState::reference_mismatch() const {
+  if (!reference.loaded()) return {};
+  ImageIdentity shown = render_identity;
+  if (published.info.width > 0) {
+    shown.width = published.info.width;
+    shown.height = published.info.height;
+  }
+  return identity_mismatch(reference_identity, shown);
 }
 
 void MeasureSettings::set_metric(ErrorMetric metric) {
@@ -104,7 +196,9 @@ bool MeasureState::refresh_layer(const MeasureSettings& settings) {
   layer_mode = mode;
   layer_options = options;
   layer_why.clear();
-  layer_ok = build_view_layer(mode, published, &reference, layer, layer_why, &options, &weight_maps);
+  layer_ok = build_view_layer(mode, published, matching_reference(), layer, layer_why, &options, &weight_maps);
+  if (!layer_ok && mode == ViewMode::Difference && reference.loaded() && !matching_reference())
+    layer_why = reference_mismatch();
   return layer_ok;
 }
 

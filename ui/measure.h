@@ -19,6 +19,14 @@
 
 namespace pdflab::ui {
 
+// "Make reference" aims at a reference whose own noise is at most this share
+// of the figures shown when it starts (about 5% of the raw relMSE), or at a
+// stated spp; a reference whose noise is more than kRoughShare of a figure
+// makes that figure rough (never shown as a plain measurement).
+inline constexpr double kTargetShare = 0.05;
+inline constexpr double kRoughShare = 0.25;
+enum class ReferenceTarget : std::uint8_t { Share, Spp };
+
 // The measuring part of ViewerSettings.
 struct MeasureSettings {
   ViewMode view_mode = ViewMode::Image;
@@ -35,10 +43,13 @@ struct MeasureSettings {
   bool plot_against_spp = false;  // false: against rendering seconds
   std::string reference_field;    // the path as typed
   // "Make reference": its size as a divisor of the render's (1, 2 or 4), its
-  // rendering time, and the share of the hardware threads it takes (at 1 the
-  // main render pauses until it is done).
+  // target (a share of the figures, or make_spp), the time it may take at
+  // most, and the share of the hardware threads it takes (at 1 the main render
+  // pauses until it is done).
   int make_divisor = 1;
-  float make_seconds = 30.0f;
+  ReferenceTarget make_target = ReferenceTarget::Share;
+  std::uint32_t make_spp = 1024;
+  float make_seconds = 120.0f;
   float make_thread_share = 0.5f;
 };
 
@@ -57,10 +68,34 @@ struct MeasureRequests {
 // there). Throws InputError naming the file when it cannot.
 using pdflab::load_reference;
 
+// What an image shows: the scene and its view, size and depth. A reference's
+// comes from its sidecar; one loaded without a sidecar (a bare PFM) is taken
+// to show the render as it was when it was loaded (`assumed`). Empty hashes
+// and zero sizes are unknown and match anything.
+struct ImageIdentity {
+  // The scene file's content hash, or for a camera moved in the viewer a hash
+  // of that and the camera (what the reference cache and film files key by).
+  std::string view_hash;
+  std::string scene_hash;  // the scene file's own content hash, when known
+  int width = 0, height = 0, max_depth = 0;
+  bool assumed = false;
+};
+// The identity a reference's sidecar gives (no hash: nothing but its size).
+ImageIdentity identity_of(const ReferenceImage& reference);
+// Empty when an image of `reference` can measure one of `render`; else one
+// line naming what differs (size, camera, scene, depth) and that the figures
+// are estimates.
+std::string identity_mismatch(const ImageIdentity& reference, const ImageIdentity& render);
+
 // The figures of one published full pass.
 struct Figures {
   bool valid = false;              // false for previews and before the first pass
   bool against_reference = false;  // rmse, relmse, efficiency measured; else only estimates
+  // With a reference loaded that does not match the image: why the figures are estimates.
+  std::string estimate_why;
+  // Measured against a reference whose own noise is more than kRoughShare of
+  // the raw error: rough, not a measurement to trust.
+  bool rough_reference = false;
   std::uint32_t spp = 0;
   double seconds = 0.0;
   // relmse is corrected for the reference's noise (metrics.h, measure_relmse):
@@ -89,6 +124,12 @@ Figures compute_figures(const ImageInfo& info, const std::vector<float>& rgb, co
                         bool unbiased = true);
 
 
+// The goal of a reference made in the viewer: a relMSE that makes its noise
+// kTargetShare of the raw error of the figures `now` shows, or the spp `s`
+// states (also when there are no figures yet), within `s`'s time limit
+// (ReferenceGoal::max_seconds). `note` says which, as a line for the panel.
+ReferenceGoal reference_goal(const MeasureSettings& s, const Figures& now, std::string& note);
+
 // A "Make reference" in progress, as the panel shows it.
 struct ReferenceBuildStatus {
   bool running = false;
@@ -96,6 +137,8 @@ struct ReferenceBuildStatus {
   int width = 0, height = 0, threads = 0;
   double fraction = 0.0, seconds_left = 0.0;
   std::uint32_t spp = 0;
+  std::string target;        // what it aims at, as a line
+  double max_seconds = 0.0;  // its time limit
 };
 
 // Everything measured so far, owned by the viewer and read by the panels.
@@ -104,6 +147,9 @@ struct MeasureState {
   bool reference_from_cache = false;  // found in the cache (or made here), not loaded by hand
   std::string reference_error;  // the last failed load, empty when fine
   std::string reference_note;   // how the reference came (cache, made), or a seed changed for it
+  bool reference_note_warns = false;  // the note is a warning (a reference short of its target)
+  ImageIdentity render_identity;      // what the viewer renders now (set when its settings apply)
+  ImageIdentity reference_identity;   // what `reference` shows
   ReferenceBuildStatus build;
   EstimateHistory history;      // of the generation on screen
   std::uint64_t history_generation = ~std::uint64_t{0};
@@ -128,6 +174,15 @@ struct MeasureState {
   void on_image(std::uint64_t current_generation, const std::string& label);
   // A new reference (or none): figures and layer follow at once.
   void set_reference(ReferenceImage image);
+  // The render's identity after a settings change; a reference that came
+  // without one takes the first it sees.
+  void set_render_identity(const ImageIdentity& identity);
+  // Empty when the reference (loaded) matches the image on screen; else why not.
+  std::string reference_mismatch() const;
+  // The reference when it can measure the image on screen, else null.
+  const ReferenceImage* matching_reference() const {
+    return reference.loaded() && reference_mismatch().empty() ? &reference : nullptr;
+  }
   // Rebuilds the layer for the view mode and its options when either or the
   // image changed; true when it did (and must be uploaded).
   bool refresh_layer(const MeasureSettings& settings);
@@ -136,6 +191,8 @@ struct MeasureState {
     s.view_mode = mode;
     return refresh_layer(s);
   }
+  // The loaded reference's identity, an assumed one filled from the render's.
+  ImageIdentity reference_identity_of_loaded() const;
   // Size mismatch against the render, empty when none or no reference.
   std::string size_mismatch(int render_width, int render_height) const {
     return reference_size_mismatch(reference, render_width, render_height);

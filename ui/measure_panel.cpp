@@ -3,6 +3,8 @@
 
 #include "renderer/integrator/integrator.h"
 #include "renderer/metrics/metrics.h"
+#include "ui/layout_report.h"
+#include "ui/panels.h"
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
@@ -26,14 +28,6 @@ constexpr ImU32 kLiveColour = IM_COL32(255, 255, 255, 255);
 
 ImU32 to_u32(const Colour& c, float alpha = 1.0f) { return ImGui::ColorConvertFloat4ToU32(ImVec4(c[0], c[1], c[2], alpha)); }
 
-void figure_row(const char* label, const char* tooltip, const char* fmt, double value) {
-  ImGui::TableNextColumn();
-  ImGui::TextColored(kDim, "%s", label);
-  if (tooltip && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tooltip);
-  ImGui::TableNextColumn();
-  ImGui::Text(fmt, value);
-}
-
 void text_row(const char* label, const char* tooltip, const std::string& value, const ImVec4* colour = nullptr) {
   ImGui::TableNextColumn();
   ImGui::TextColored(kDim, "%s", label);
@@ -43,13 +37,33 @@ void text_row(const char* label, const char* tooltip, const std::string& value, 
   else ImGui::TextUnformatted(value.c_str());
 }
 
+// One line that never wraps (cut with "...", the whole text in the tooltip).
+void one_line(const std::string& text, const ImVec4& colour, float leave = 0.0f) {
+  const float room = ImGui::GetContentRegionAvail().x - leave;
+  std::string shown = text;
+  std::replace(shown.begin(), shown.end(), '\n', ' ');
+  if (ImGui::CalcTextSize(shown.c_str()).x > room) {
+    while (!shown.empty() && ImGui::CalcTextSize((shown + "...").c_str()).x > room) shown.pop_back();
+    shown += "...";
+  }
+  ImGui::TextColored(colour, "%s", shown.c_str());
+  if (shown.size() != text.size() && ImGui::IsItemHovered()) {
+    ImGui::BeginTooltip();
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+    ImGui::TextUnformatted(text.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::EndTooltip();
+  }
+}
+
 std::string printed(const char* fmt, double a, double b = 0.0) {
   char buf[64];
   std::snprintf(buf, sizeof buf, fmt, a, b);
   return buf;
 }
 
-// "Make reference": the button and its settings, or the running build's progress.
+// "Make reference": the button and its settings, or the running build's
+// progress, in three lines either way.
 void make_reference_controls(MeasureSettings& ms, const MeasureState& m, const UiStatus& status,
                              UiRequests& requests) {
   const ReferenceBuildStatus& b = m.build;
@@ -59,15 +73,23 @@ void make_reference_controls(MeasureSettings& ms, const MeasureState& m, const U
     else std::snprintf(overlay, sizeof overlay, "%d%%  ~%.0f s left  %u spp", static_cast<int>(b.fraction * 100.0),
                        b.seconds_left, b.spp);
     ImGui::ProgressBar(static_cast<float>(b.fraction), ImVec2(-1.0f, 0.0f), overlay);
-    ImGui::TextColored(kDim, "Making a reference: %dx%d on %d threads", b.width, b.height, b.threads);
+    layout::item("measure.reference_progress");
+    char line[128];
+    std::snprintf(line, sizeof line, "Making a reference: %dx%d on %d thread%s, at most %.0f s", b.width, b.height,
+                  b.threads, b.threads == 1 ? "" : "s", b.max_seconds);
+    one_line(line, kDim);
+    one_line(b.target, kDim);
     ImGui::SameLine();
     if (ImGui::SmallButton("Cancel##reference")) requests.measure.cancel_reference = true;
+    layout::item("measure.cancel_reference");
     return;
   }
   if (ImGui::Button("Make reference")) requests.measure.make_reference = true;
+  layout::item("measure.make_reference");
   if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("Renders a reference in the background (unbiased, seeds no render uses) and stores it in\n"
-                      "the reference cache; then every figure is measured against it.");
+    ImGui::SetTooltip("Renders a reference in the background (unbiased, seeds no render uses) to its target, and\n"
+                      "stores it in the reference cache; then every figure is measured against it. One stopped by\n"
+                      "its time limit short of the target is kept for this session only.");
   ImGui::SameLine();
   const int w = status.width, h = status.height;
   char sizes[3][48];
@@ -82,8 +104,38 @@ void make_reference_controls(MeasureSettings& ms, const MeasureState& m, const U
     ImGui::EndCombo();
   }
   ms.make_divisor = 1 << choice;
+  // The target: a share of the figures shown now, or a stated spp.
+  char share_label[48];
+  std::snprintf(share_label, sizeof share_label, "noise <= %.0f%% of now", 100.0 * kTargetShare);
+  const char* targets[] = {share_label, "spp"};
+  int target = ms.make_target == ReferenceTarget::Spp ? 1 : 0;
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
-  ImGui::SliderFloat("##make seconds", &ms.make_seconds, 5.0f, 600.0f, "%.0f s", ImGuiSliderFlags_Logarithmic);
+  if (ImGui::BeginCombo("##make target", targets[target])) {
+    for (int i = 0; i < 2; ++i) {
+      if (ImGui::Selectable(targets[i], target == i)) target = i;
+      layout::item(i == 0 ? "measure.target.share" : "measure.target.spp");
+    }
+    ImGui::EndCombo();
+  }
+  layout::item("measure.make_target");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("noise <= %.0f%%: a reference whose own noise is at most %.0f%% of the raw error of the\n"
+                      "figures shown now (a relMSE %.3g of theirs); spp: as many samples per pixel as set.",
+                      100.0 * kTargetShare, 100.0 * kTargetShare, kTargetShare / (1.0 - kTargetShare));
+  ms.make_target = target == 1 ? ReferenceTarget::Spp : ReferenceTarget::Share;
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
+  if (ms.make_target == ReferenceTarget::Spp) {
+    int spp = static_cast<int>(ms.make_spp);
+    if (ImGui::InputInt("##make spp", &spp, 64, 1024)) ms.make_spp = static_cast<std::uint32_t>(std::clamp(spp, 1, 1 << 20));
+    layout::item("measure.make_spp");
+  } else {
+    ImGui::TextColored(kDim, "(%s)", m.figures.valid ? "from the figures" : "waits for figures: spp");
+  }
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+  ImGui::SliderFloat("##make seconds", &ms.make_seconds, 2.0f, 1800.0f, "at most %.0f s", ImGuiSliderFlags_Logarithmic);
+  layout::item("measure.make_seconds");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Its time limit: it stops by then, target reached or not.");
   ImGui::SameLine();
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
   float percent = ms.make_thread_share * 100.0f;
@@ -122,25 +174,29 @@ void draw_colour_bar(const ColourScale& scale, float width) {
   ImGui::Dummy(ImVec2(width, bar_h + 3.0f + ImGui::GetFontSize()));
 }
 
-void draw_legend_window(const ImageRect& area, const ViewerSettings& settings, const MeasureState& m,
-                        ImVec2 badges) {
+void draw_legend_window(const ViewerSettings& settings, const MeasureState& m) {
   const ViewMode mode = settings.measure.view_mode;
-  // Narrower than the area, so the window never pokes out of its left edge.
-  const float width = std::min(area.width - 40.0f, ImGui::GetFontSize() * 18.0f);
-  if (width < 80.0f) return;
-  // Top right of the image area; below the badges at its top left when the
-  // two would overlap.
-  const float right = area.x + area.width - 8.0f;
-  const float left = right - width - 2.0f * ImGui::GetStyle().WindowPadding.x;
-  const float top = badges.y > 0.0f && left < badges.x + 4.0f ? badges.y + 4.0f : area.y + 8.0f;
-  ImGui::SetNextWindowPos(ImVec2(right, top), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+  // Top right of the image area, clear of the other boxes and the image's middle.
+  layout::Overlay place;
+  place.corner = Corner::TopRight;
+  place.width = ImGui::GetFontSize() * 18.0f + 2.0f * ImGui::GetStyle().WindowPadding.x;
+  place.min_width = 9.0f;
+  place.min_lines = 3.0f;
+  float width = 0.0f;
+  if (!layout::place_next_window("##view legend", place, &width)) return;
   ImGui::SetNextWindowBgAlpha(0.8f);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                  ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
   if (ImGui::Begin("##view legend", nullptr, flags)) {
     ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + width);
-    ImGui::TextColored(kAmber, "View: %s (V)", view_mode_label(mode));
+    // The heat map and the difference view name their metric, not only the view.
+    const bool metric_view = mode == ViewMode::RelativeError || mode == ViewMode::Difference;
+    if (metric_view)
+      ImGui::TextColored(kAmber, "View: %s, %s (V, E)", mode == ViewMode::RelativeError ? "noise heat map" : "difference",
+                         error_metric_label(mode, settings.measure.layer_options(mode).metric));
+    else
+      ImGui::TextColored(kAmber, "View: %s (V)", view_mode_label(mode));
     if (!m.layer_ok) {
       ImGui::TextColored(kDim, "Showing the image: %s.", m.layer_why.empty() ? "nothing to show" : m.layer_why.c_str());
     } else if (mode == ViewMode::Drops) {
@@ -208,10 +264,21 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
   const LogRange xr = log_range(xs);
   const LogRange yr = log_range(ys);
 
+  // The legend has a column of its own right of the frame, so however many
+  // curves are pinned it never covers one.
+  const float font = ImGui::GetFontSize();
+  std::vector<std::pair<ImU32, std::string>> entries;
+  for (std::size_t i = 0; i + 1 < curves.size(); ++i)
+    entries.emplace_back(kPinColours[i % std::size(kPinColours)], "pin: " + curve_label(*curves[i]));
+  if (!rec.live().points.empty()) entries.emplace_back(kLiveColour, "now: " + curve_label(rec.live()));
+  float widest = 0.0f;
+  for (const auto& e : entries) widest = std::max(widest, ImGui::CalcTextSize(e.second.c_str()).x);
+  if (anchor_curve) widest = std::max(widest, ImGui::CalcTextSize("1/sqrt(N) slope").x);
+  const float legend_w = std::min(widest + font * 2.2f, size.x * 0.42f);
+
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const ImVec2 origin = ImGui::GetCursorScreenPos();
-  const float font = ImGui::GetFontSize();
-  const float left = font * 3.2f, bottom = font * 2.4f, top = font * 0.5f, right = font * 0.8f;
+  const float left = font * 3.2f, bottom = font * 2.4f, top = font * 0.5f, right = font * 0.8f + legend_w;
   const ImVec2 a(origin.x + left, origin.y + top);
   const ImVec2 b(origin.x + size.x - right, origin.y + size.y - bottom);
   ImGui::Dummy(size);
@@ -262,17 +329,11 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
   const char* xlabel = by_spp ? "samples per pixel" : "rendering time (s)";
   dl->AddText(ImVec2((a.x + b.x - ImGui::CalcTextSize(xlabel).x) * 0.5f, b.y + font * 1.25f), text, xlabel);
 
-  // Legend, top right inside the frame.
-  const auto curve_name = [](const Curve& c, const char* prefix) {
-    return prefix + (c.label.empty() ? std::string("-") : c.label) + (c.estimated ? " (est.)" : "");
-  };
-  // Right-aligned on the longest entry, so a long mixture name stays inside the frame.
-  float widest = ImGui::CalcTextSize("1/sqrt(N) slope").x;
-  for (std::size_t i = 0; i < curves.size(); ++i)
-    widest = std::max(widest, ImGui::CalcTextSize(curve_name(*curves[i], i + 1 < curves.size() ? "pin: " : "now: ").c_str()).x);
-  float ly = a.y + 4.0f;
-  const float lx = std::max(a.x + 4.0f, b.x - widest - font * 2.4f);
-  const auto legend_line = [&](ImU32 colour, const std::string& label, bool dashed) {
+  // The legend's column: a swatch and the curve's name (strategy, size), cut to fit.
+  const float lx = b.x + font * 0.6f, text_room = legend_w - font * 2.2f;
+  float ly = a.y;
+  const auto legend_line = [&](ImU32 colour, std::string label, bool dashed) {
+    if (ly + font > origin.y + size.y) return;
     if (dashed) {
       for (float k = 0.0f; k < 3.0f; k += 1.0f)
         dl->AddLine(ImVec2(lx + k * font * 0.6f, ly + font * 0.5f),
@@ -280,23 +341,32 @@ void draw_plot(const ViewerSettings& settings, const MeasureState& m, ImVec2 siz
     } else {
       dl->AddLine(ImVec2(lx, ly + font * 0.5f), ImVec2(lx + font * 1.6f, ly + font * 0.5f), colour, 2.0f);
     }
+    if (ImGui::CalcTextSize(label.c_str()).x > text_room) {
+      while (!label.empty() && ImGui::CalcTextSize((label + "...").c_str()).x > text_room) label.pop_back();
+      label += "...";
+    }
     dl->AddText(ImVec2(lx + font * 2.0f, ly), text, label.c_str());
     ly += font * 1.15f;
   };
-  for (std::size_t i = 0; i + 1 < curves.size(); ++i)
-    legend_line(kPinColours[i % std::size(kPinColours)], curve_name(*curves[i], "pin: "), false);
-  if (!rec.live().points.empty()) legend_line(kLiveColour, curve_name(rec.live(), "now: "), false);
+  for (const auto& [colour, label] : entries) legend_line(colour, label, false);
   if (anchor_curve) legend_line(IM_COL32(170, 170, 170, 220), "1/sqrt(N) slope", true);
 }
 
-void draw_convergence_window(const ImageRect& area, ViewerSettings& settings, const MeasureState& m,
-                             UiRequests& requests) {
+// The convergence plot, bottom left of the image area: a plot that would rather
+// be shorter than narrower. False when the area has no room for it.
+bool draw_convergence_window(ViewerSettings& settings, const MeasureState& m, UiRequests& requests) {
   const float font = ImGui::GetFontSize();
-  const float w = std::min(area.width - 16.0f, font * 34.0f);
-  const float h = std::min(area.height * 0.5f, font * 21.0f);
-  if (w < font * 12.0f || h < font * 8.0f) return;
-  ImGui::SetNextWindowPos(ImVec2(area.x + 8.0f, area.y + area.height - 8.0f), ImGuiCond_Always, ImVec2(0.0f, 1.0f));
-  ImGui::SetNextWindowSize(ImVec2(w, h), ImGuiCond_Always);
+  layout::Overlay o;
+  o.corner = Corner::BottomLeft;
+  o.width = font * 38.0f;
+  o.height = font * 21.0f;
+  o.min_width = 14.0f;
+  o.min_lines = 6.0f;
+  o.prefer_narrow = false;
+  if (!layout::place_next_window("Convergence (G)", o)) return false;
+  // Its size is what the planner gave (the constraint's maximum), every frame.
+  const Box& area = layout::area();
+  ImGui::SetNextWindowSize(ImVec2(std::min(o.width, area.w), std::min(o.height, area.h)), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.88f);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoSavedSettings |
                                  ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoScrollbar |
@@ -315,14 +385,21 @@ void draw_convergence_window(const ImageRect& area, ViewerSettings& settings, co
     settings.measure.plot_against_spp = axis == 1;
     const float buttons = ImGui::GetFrameHeightWithSpacing();
     draw_plot(settings, m, ImVec2(ImGui::GetContentRegionAvail().x, ImGui::GetContentRegionAvail().y - buttons));
-    if (ImGui::SmallButton("Pin this curve (K)")) requests.measure.pin_curve = true;
+    if (ImGui::SmallButton("Pin (K)")) requests.measure.pin_curve = true;
+    layout::item("plot.pin");
     ImGui::SameLine();
-    if (ImGui::SmallButton("Clear pins")) requests.measure.clear_pins = true;
+    if (ImGui::SmallButton("Clear")) requests.measure.clear_pins = true;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Clear the pinned curves");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Export")) requests.export_convergence = true;
+    layout::item("plot.export");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("The curves as SVG and CSV, in the screenshot folder");
     ImGui::SameLine();
     ImGui::TextColored(kDim, "%zu pinned", m.curves.pins().size());
   }
   ImGui::End();
   if (!open) settings.measure.show_plot = false;
+  return true;
 }
 
 }  // namespace
@@ -354,7 +431,9 @@ void draw_layer_controls(ViewerSettings& settings, const MeasureState* m) {
   }
   const bool signed_metric = mode == ViewMode::Difference && o.metric == ErrorMetric::Signed;
   bool automatic = o.range.automatic;
-  if (ImGui::Checkbox("auto range", &automatic)) {
+  const bool toggled = ImGui::Checkbox("auto range", &automatic);
+  layout::item("display.auto_range");
+  if (toggled) {
     // Set by hand from where the automatic range was, so nothing jumps.
     if (!automatic && m && m->layer_ok && m->layer_mode == mode) {
       o.range.lo = m->layer.scale.diverging ? -m->layer.scale.hi : m->layer.scale.lo;
@@ -377,10 +456,19 @@ void draw_layer_controls(ViewerSettings& settings, const MeasureState* m) {
   } else {
     const float half = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) * 0.5f;
     ImGui::SetNextItemWidth(half);
-    if (ImGui::SliderFloat("##range lo", &lo, 1e-9f, 1e6f, "min %.3g", log)) o.range.lo = std::min(lo, hi * 0.999f);
+    // The two ends never meet: moving one past the other pushes the other along.
+    if (ImGui::SliderFloat("##range lo", &lo, 1e-9f, 1e6f, "min %.3g", log)) {
+      o.range.lo = lo;
+      o.range.hi = std::max(static_cast<double>(hi), lo * kMinRangeRatio);
+    }
+    layout::item("display.range_min");
     ImGui::SameLine();
     ImGui::SetNextItemWidth(half);
-    if (ImGui::SliderFloat("##range hi", &hi, 1e-9f, 1e6f, "max %.3g", log)) o.range.hi = std::max(hi, lo * 1.001f);
+    if (ImGui::SliderFloat("##range hi", &hi, 1e-9f, 1e6f, "max %.3g", log)) {
+      o.range.hi = hi;
+      o.range.lo = std::min(static_cast<double>(lo), hi / kMinRangeRatio);
+    }
+    layout::item("display.range_max");
   }
   ImGui::EndDisabled();
   o.range = sanitized(o.range, signed_metric);
@@ -396,140 +484,188 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
                           style.FramePadding.x * 2.0f - style.ItemSpacing.x);
   const bool entered = ImGui::InputTextWithHint("##reference", "reference image (.pfm)", &ms.reference_field,
                                                 ImGuiInputTextFlags_EnterReturnsTrue);
+  layout::item("measure.reference_field");
   ImGui::SameLine();
   if ((ImGui::Button("Load##reference") || entered) && !ms.reference_field.empty())
     requests.measure.load_reference = ms.reference_field;
+  layout::item("measure.load_reference");
+
+  // The reference in two lines, whatever it is: what it is, then how it came
+  // or why it does not measure the render (with what would make it).
   if (m->reference.loaded()) {
     const ReferenceInfo& ri = m->reference.info;
-    ImGui::TextColored(kDim, "reference: %s, %dx%d",
-                       m->reference_from_cache ? "from the cache"
-                                               : std::filesystem::path(m->reference.path).filename().string().c_str(),
-                       m->reference.width, m->reference.height);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", m->reference.path.c_str());
-    ImGui::SameLine();
+    char line[200];
+    const std::string spp = ri.spp > 0 ? ", " + std::to_string(ri.spp) + " spp" : std::string();
+    std::snprintf(line, sizeof line, "reference: %s, %dx%d%s%s",
+                  m->reference_from_cache ? "from the cache"
+                                          : std::filesystem::path(m->reference.path).filename().string().c_str(),
+                  m->reference.width, m->reference.height, spp.c_str(),
+                  m->reference.has_variance() ? "" : ", no variance");
+    const float drop_w = ImGui::CalcTextSize("Drop").x + style.FramePadding.x * 2.0f + style.ItemSpacing.x;
+    one_line(line, kDim, drop_w);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s\n%s%s", m->reference.path.c_str(), ri.strategy.empty() ? "strategy unknown" : ri.strategy.c_str(),
+                        m->reference.has_variance() ? "" : "\nno variance: its noise is not removed");
+    ImGui::SameLine(std::max(0.0f, ImGui::GetWindowContentRegionMax().x - drop_w + style.ItemSpacing.x));
     if (ImGui::SmallButton("Drop")) requests.measure.clear_reference = true;
-    if (ri.spp > 0 || !ri.strategy.empty())
-      ImGui::TextColored(kDim, "  %u spp, %s%s", ri.spp, ri.strategy.empty() ? "?" : ri.strategy.c_str(),
-                         m->reference.has_variance() ? "" : ", no variance: its noise is not removed");
+    layout::item("measure.drop_reference");
   } else {
-    ImGui::TextColored(kDim, "No reference: errors below are estimates (lower bounds).");
+    one_line("No reference: the figures are estimates (lower bounds).", kDim);
   }
-  if (!m->reference_note.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, kGreen);
-    ImGui::TextWrapped("%s", m->reference_note.c_str());
-    ImGui::PopStyleColor();
-  }
+  const std::string why = m->reference_mismatch();
+  const std::string size_mismatch = m->size_mismatch(status.width, status.height);
   if (!m->reference_error.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, kRed);
-    ImGui::TextWrapped("%s", m->reference_error.c_str());
-    ImGui::PopStyleColor();
+    one_line(m->reference_error, kRed);
+  } else if (!why.empty()) {
+    if (!size_mismatch.empty()) {
+      char label[64];
+      std::snprintf(label, sizeof label, "Render at %dx%d", m->reference.width, m->reference.height);
+      if (ImGui::SmallButton(label)) requests.measure.render_at_reference_size = true;
+      layout::item("measure.render_at_reference_size");
+      ImGui::SameLine();
+    }
+    one_line(why, kAmber);
+  } else if (!m->reference_note.empty()) {
+    one_line(m->reference_note, m->reference_note_warns ? kAmber : kGreen);
+  } else {
+    ImGui::TextUnformatted(" ");
   }
   make_reference_controls(ms, *m, status, requests);
-  const std::string mismatch = m->size_mismatch(status.width, status.height);
-  if (!mismatch.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, kAmber);
-    ImGui::TextWrapped("%s", mismatch.c_str());
-    ImGui::PopStyleColor();
-    char label[64];
-    std::snprintf(label, sizeof label, "Render at %dx%d", m->reference.width, m->reference.height);
-    if (ImGui::Button(label)) requests.measure.render_at_reference_size = true;
-  }
 
+  // The figures: the same rows measured or not ("-" where there is no figure),
+  // so the table keeps its height when a reference comes or goes.
   const Figures& f = m->figures;
-  if (!f.valid) {
-    ImGui::TextColored(kDim, "Figures appear after the first full pass.");
-  } else {
-    ImGui::TextColored(f.against_reference ? kGreen : kAmber, f.against_reference
-                                                                  ? "MEASURED against the reference"
-                                                                  : "ESTIMATED from the film's own variance");
-    if (ImGui::BeginTable("figures", 2, ImGuiTableFlags_SizingStretchProp)) {
-      share_columns({0.56f, 0.44f});
-      if (f.against_reference) {
-        figure_row("RMSE", "root mean squared error against the reference, all pixels and channels", "%.5g", f.rmse);
-        text_row("relMSE (eps 1e-2)",
-                 "mean of ((x - r)^2 - var(r)) / (r^2 + 0.01): the error against the true image, the reference's own\n"
-                 "noise removed, with its 95% interval (docs/measuring.md)",
-                 printed("%.4g +- %.2g", f.relmse, f.relmse_interval));
-        text_row("relMSE raw", "mean of (x - r)^2 / (r^2 + 0.01), the reference's noise included",
-                 printed("%.4g", f.relmse_raw));
-        const ImVec4 share_colour = f.reference_share > 0.2 ? kAmber : kDim;
-        text_row("reference's share", "the reference's own noise as a part of the raw relMSE",
-                 f.reference_corrected ? printed("%.1f%%", 100.0 * f.reference_share) : std::string("unknown"),
-                 &share_colour);
-        if (f.relmse > 0.0)
-          figure_row("efficiency", "1 / (relMSE * seconds): higher is better, flat over time when unbiased", "%.5g",
-                     f.efficiency);
-        else
-          text_row("efficiency", "relMSE is within the reference's noise of 0", "beyond the reference's precision");
-      }
-      figure_row("mean rel. std. error",
-                 "the film's own noise: sqrt(variance of the mean) / mean, averaged over pixels", "%.5g",
-                 f.mean_relative_standard_error);
-      figure_row(f.against_reference ? "relMSE, estimated" : "relMSE ESTIMATE (lower bound)",
-                 "variance of the mean / (mean^2 + 0.01): the expected relMSE of an unbiased strategy, at best.\n"
-                 "Blind to what the samples never found (a biased strategy looks good here).",
-                 "%.5g", f.estimated_relmse);
-      if (f.unbiased)
-        figure_row(f.against_reference ? "efficiency, estimated" : "efficiency ESTIMATE",
-                   "1 / (estimated relMSE * seconds)", "%.5g", f.estimated_efficiency);
-      else if (!f.against_reference)
-        text_row("efficiency", nullptr, "none: biased strategy", &kRed);
-      ImGui::EndTable();
-    }
-    if (!f.unbiased && !f.against_reference)
-      ImGui::TextWrapped("No efficiency without a reference: this strategy never samples indirect light, so its own "
-                         "variance hides the light it misses and would rank it best.");
-    if (f.estimate_unreliable && !f.against_reference) {
-      ImGui::PushStyleColor(ImGuiCol_Text, kAmber);
-      ImGui::TextWrapped("The estimate is unreliable: it did not fall as the samples doubled (rare bright paths are "
-                         "still being found). Make a reference to measure.");
-      ImGui::PopStyleColor();
-    }
+  const bool measured = f.valid && f.against_reference;
+  if (!f.valid) ImGui::TextColored(kDim, "Figures appear after the first full pass.");
+  else if (measured && f.rough_reference)
+    ImGui::TextColored(kAmber, "ROUGH: the reference's own noise is %.0f%% of the error", 100.0 * f.reference_share);
+  else if (measured)
+    ImGui::TextColored(kGreen, "MEASURED against the reference");
+  else
+    ImGui::TextColored(kAmber, "ESTIMATED from the film's own variance");
+  layout::item("measure.source");
+  if (measured && f.rough_reference && ImGui::IsItemHovered())
+    ImGui::SetTooltip("A reference whose noise is more than %.0f%% of the raw error says little about the render:\n"
+                      "make a better one (Make reference aims at %.0f%%).",
+                      100.0 * kRoughShare, 100.0 * kTargetShare);
+  const auto dash = [&](bool known, const std::string& value) { return known ? value : std::string("-"); };
+  if (ImGui::BeginTable("figures", 2, ImGuiTableFlags_SizingStretchProp)) {
+    share_columns({0.56f, 0.44f});
+    const ImVec4 measured_colour = f.rough_reference ? kAmber : ImVec4(0.92f, 0.92f, 0.95f, 1.0f);
+    text_row("relMSE (eps 1e-2)",
+             "mean of ((x - r)^2 - var(r)) / (r^2 + 0.01): the error against the true image, the reference's own\n"
+             "noise removed, with its 95% interval (docs/measuring.md)",
+             dash(measured, printed("%.4g +- %.2g", f.relmse, f.relmse_interval)), &measured_colour);
+    text_row("relMSE raw", "mean of (x - r)^2 / (r^2 + 0.01), the reference's noise included",
+             dash(measured, printed("%.4g", f.relmse_raw)));
+    const ImVec4 share_colour = f.reference_share > kRoughShare ? kAmber : kDim;
+    text_row("reference's share", "the reference's own noise as a part of the raw relMSE",
+             dash(measured, f.reference_corrected ? printed("%.1f%%", 100.0 * f.reference_share) : std::string("unknown")),
+             &share_colour);
+    text_row("efficiency", "1 / (relMSE * seconds): higher is better, flat over time when unbiased",
+             !measured ? std::string("-")
+                       : (f.relmse > 0.0 ? printed("%.5g", f.efficiency) : std::string("beyond the reference")),
+             &measured_colour);
+    text_row("mean rel. std. error", "the film's own noise: sqrt(variance of the mean) / mean, averaged over pixels",
+             dash(f.valid, printed("%.5g", f.mean_relative_standard_error)));
+    text_row("relMSE ESTIMATE (lower bound)",
+             "variance of the mean / (mean^2 + 0.01): the expected relMSE of an unbiased strategy, at best.\n"
+             "Blind to what the samples never found (a biased strategy looks good here).",
+             dash(f.valid, printed("%.5g", f.estimated_relmse)));
+    if (f.valid && !f.unbiased)
+      text_row("efficiency ESTIMATE",
+               "No efficiency without a reference: this strategy never samples indirect light, so its own\n"
+               "variance hides the light it misses and would rank it best.",
+               "none: biased", &kRed);
+    else
+      text_row("efficiency ESTIMATE", "1 / (estimated relMSE * seconds)", dash(f.valid, printed("%.5g", f.estimated_efficiency)));
+    ImGui::EndTable();
+  }
+  // One reserved line: the estimate's reliability, or where the figures stand.
+  if (f.valid && f.estimate_unreliable && !measured) {
+    one_line("The estimate is unreliable now: it did not fall as the samples doubled.", kAmber);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("Rare bright paths are still being found, so the variance the film sees is not yet the\n"
+                        "strategy's. The warning clears once the estimate falls as 1/spp again; or make a reference.");
+  } else if (f.valid) {
     ImGui::TextColored(kDim, "at %u spp, %.2f s of rendering", f.spp, f.seconds);
+  } else {
+    ImGui::TextUnformatted(" ");
   }
   ImGui::Checkbox("Convergence plot (G)", &ms.show_plot);
+  layout::item("measure.plot");
   ImGui::SameLine();
   if (ImGui::Button("Pin")) requests.measure.pin_curve = true;
   ImGui::SameLine();
   if (ImGui::Button("Clear pins")) requests.measure.clear_pins = true;
 }
 
-void draw_nee_explanation() {
+void draw_nee_explanation(const SamplingSettings& s) {
   // Closed at first: the note is long, the panel is for controls.
-  if (!ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None)) return;
+  const bool open = ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None);
+  layout::item("sampling.nee_why");
+  if (!open) return;
+  // What continues the path: cosine alone (plain nee-mis) or a mixture (fastest's).
+  const Strategy strategy = s.strategy();
+  std::string continuation;
+  bool cosine_alone = true;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    if (!(strategy.weights[i] > 0.0f)) continue;
+    if (static_cast<Technique>(i) != Technique::Cosine) cosine_alone = false;
+    char part[64];
+    std::snprintf(part, sizeof part, "%s%s %.2g", continuation.empty() ? "" : " + ",
+                  std::string(technique_name(static_cast<Technique>(i))).c_str(), static_cast<double>(strategy.weights[i]));
+    continuation += part;
+  }
   ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.85f, 0.85f, 0.88f, 1.0f));
   ImGui::TextWrapped(
       "A mixture (mix:...) draws ONE direction per bounce: it picks a technique by its weight, samples it, and "
       "divides by the mixture's density sum w_i p_i. That is the balance heuristic of MIS in one-sample form.");
   ImGui::Spacing();
-  ImGui::TextWrapped(
-      "nee-mis takes TWO samples at every diffuse vertex: a light sample (an emitter chosen by power, sampled by "
-      "solid angle) tested with a shadow ray, and a cosine sample that continues the path. Each is weighted "
-      "against the OTHER technique's pdf for the same direction: power heuristic p_a^2 / (p_a^2 + p_b^2), or "
-      "balance p_a / (p_a + p_b). Every path to a light is counted once in total.");
-  ImGui::Spacing();
-  ImGui::TextWrapped(
-      "Unbiased: the cosine sample reaches every direction. Per sample, noise from small lights falls much "
-      "faster; but a bounce costs a shadow ray more and paths, continued by cosine sampling alone, rarely end "
-      "on a light, so per second it "
-      "wins mainly where light comes straight from the lights (compare with the Convergence plot). It aims at "
-      "emitters only, not at the glass sphere.");
+  if (cosine_alone) {
+    ImGui::TextWrapped(
+        "nee-mis takes TWO samples at every diffuse vertex: a light sample (an emitter chosen by power, sampled by "
+        "solid angle) tested with a shadow ray, and a cosine sample that continues the path. Each is weighted "
+        "against the OTHER technique's pdf for the same direction: power heuristic p_a^2 / (p_a^2 + p_b^2), or "
+        "balance p_a / (p_a + p_b). Every path to a light is counted once in total.");
+    ImGui::Spacing();
+    ImGui::TextWrapped(
+        "Unbiased: the cosine sample reaches every direction. Per sample, noise from small lights falls much "
+        "faster; but a bounce costs a shadow ray more and paths, continued by cosine sampling alone, rarely end "
+        "on a light, so per second it wins mainly where light comes straight from the lights (compare with the "
+        "Convergence plot). It aims at emitters only, not at the glass sphere.");
+  } else {
+    ImGui::TextWrapped(
+        "This strategy takes TWO samples at every diffuse vertex: a light sample (an emitter chosen by power) "
+        "tested with a shadow ray, and a sample of the mixture %s that continues the path. The light sample is "
+        "weighted against the MIXTURE's density for its direction and emission the continuation reaches against "
+        "the light technique's, by the %s heuristic, so every path to a light is counted once in total.",
+        continuation.c_str(), strategy.heuristic == MisHeuristic::Power ? "power" : "balance");
+    ImGui::Spacing();
+    ImGui::TextWrapped(
+        "Unbiased while the mixture has a technique that reaches every direction (cosine). Its other techniques aim "
+        "the continuation: specular-objects at the glass and metal objects, so paths through the book's glass "
+        "sphere (its caustic) are found far more often than by cosine sampling alone.%s",
+        strategy.sobol || strategy.roulette_depth > 0
+            ? " Sobol points stratify the first bounce, and Russian roulette ends long paths early."
+            : "");
+  }
   ImGui::PopStyleColor();
   ImGui::TreePop();
 }
 
-void draw_image_overlays(const ImageRect& image, const ImageRect& area, ViewerSettings& settings,
-                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests,
-                         ImVec2 badges) {
+void draw_image_overlays(const ImageRect& image, ViewerSettings& settings, const MeasureState& measure,
+                         std::uint32_t texture, UiRequests& requests) {
   const ViewMode mode = settings.measure.view_mode;
   if (mode != ViewMode::Image) {
     if (measure.layer_ok && texture != 0 && image.width > 0.0f)
       ImGui::GetBackgroundDrawList()->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(texture)),
                                                ImVec2(image.x, image.y),
                                                ImVec2(image.x + image.width, image.y + image.height));
-    draw_legend_window(area, settings, measure, badges);
+    draw_legend_window(settings, measure);
   }
-  if (settings.measure.show_plot) draw_convergence_window(area, settings, measure, requests);
+  if (settings.measure.show_plot && !draw_convergence_window(settings, measure, requests))
+    draw_hint("No room for the convergence plot here: hide the panel (Tab) or lower the UI scale");
 }
 
 }  // namespace pdflab::ui

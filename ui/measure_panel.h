@@ -20,14 +20,12 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
 void draw_view_mode_selector(ViewerSettings& settings);
 // The heat map's and difference view's metric and range (nothing for the other views).
 void draw_layer_controls(ViewerSettings& settings, const MeasureState* measure);
-// "How is this different?": nee-mis against the book's one-sample mixture.
-void draw_nee_explanation();
-// The false-colour layer (texture: ViewTexture::id, 0 for none), its legend,
-// and the convergence plot, over the image area. badges: the bottom-right
-// corner of the image badges (draw_image_badges), which the legend moves below
-// when the area is too narrow for both side by side.
-void draw_image_overlays(const ImageRect& image, const ImageRect& area, ViewerSettings& settings,
-                         const MeasureState& measure, std::uint32_t texture, UiRequests& requests,
-                         ImVec2 badges = ImVec2(0.0f, 0.0f));
+// "How is this different?": nee-mis (with the continuation `s` has: cosine
+// alone, or fastest's mixture) against the book's one-sample mixture.
+void draw_nee_explanation(const SamplingSettings& s);
+// The false-colour layer (texture: ViewTexture::id, 0 for none) over the
+// image, its legend and the convergence plot, placed by ui/layout_report.
+void draw_image_overlays(const ImageRect& image, ViewerSettings& settings, const MeasureState& measure,
+                         std::uint32_t texture, UiRequests& requests);
 
 }  // namespace pdflab::ui

@@ -2,6 +2,7 @@
 #include "ui/style.h"
 
 #include "renderer/integrator/integrator.h"
+#include "ui/layout_report.h"
 #include "ui/measure_panel.h"
 #include "ui/split_view.h"
 
@@ -35,88 +36,191 @@ void stat_cell(const char* label, const char* fmt, auto... args) {
   ImGui::Text(fmt, args...);
 }
 
-// Beside the w slider: the efficiency predicted at every w from the paths
-// drawn so far, the predicted best marked, a button that moves the slider
-// there, auto weight and its history, and why the sampling weight keeps away
-// from 0 and 1 while predicting.
-void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int a, int b) {
-  SamplingSettings& s = settings.sampling;
-  const std::string name_a(technique_name(static_cast<Technique>(a))), name_b(technique_name(static_cast<Technique>(b)));
-  if (!c.active) {
-    ImGui::TextColored(kDim, "Predicted efficiency: %s", c.why.c_str());
-  } else {
-    ImGui::TextColored(kDim, "Predicted efficiency against w (%llu paths)", static_cast<unsigned long long>(c.paths));
-    const float width = ImGui::GetContentRegionAvail().x, height = ImGui::GetFontSize() * 5.0f;
-    const ImVec2 p0 = ImGui::GetCursorScreenPos();
-    ImGui::PlotLines("##predicted", c.relative_efficiency.data(), static_cast<int>(c.relative_efficiency.size()), 0,
-                     nullptr, 0.0f, 1.05f, ImVec2(width, height));
-    const auto heavy = [&](std::size_t i) { return i < c.largest_share.size() && c.largest_share[i] > c.dominant_share; };
-    if (ImGui::IsItemHovered()) {
-      const float t = std::clamp((ImGui::GetIO().MousePos.x - p0.x) / width, 0.0f, 1.0f);
-      const std::size_t i = static_cast<std::size_t>(std::lround(t * static_cast<float>(c.weight.size() - 1)));
+// One line of text that never wraps: cut with "..." where the panel ends, the
+// whole text in its tooltip. What keeps a message from pushing controls down.
+void one_line(const std::string& text, const ImVec4& colour, const char* tooltip_extra = nullptr, float leave = 0.0f) {
+  const float room = ImGui::GetContentRegionAvail().x - leave;
+  std::string shown = text;
+  std::replace(shown.begin(), shown.end(), '\n', ' ');
+  if (ImGui::CalcTextSize(shown.c_str()).x > room) {
+    while (!shown.empty() && ImGui::CalcTextSize((shown + "...").c_str()).x > room) shown.pop_back();
+    shown += "...";
+  }
+  ImGui::TextColored(colour, "%s", shown.c_str());
+  if (ImGui::IsItemHovered() && (shown.size() != text.size() || tooltip_extra)) {
+    ImGui::BeginTooltip();
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+    ImGui::TextUnformatted(text.c_str());
+    if (tooltip_extra) ImGui::TextUnformatted(tooltip_extra);
+    ImGui::PopTextWrapPos();
+    ImGui::EndTooltip();
+  }
+}
+
+// The predicted curve's box: relative efficiency 0..1 against w 0..1, with
+// ticks on both axes. Greyed (a curve of an earlier generation while the next
+// is computed) when `current` is false. Always the same size, curve or not.
+void weight_curve_plot(const WeightCurveStatus& c, bool current, const std::string& note) {
+  const float font = ImGui::GetFontSize();
+  const float width = ImGui::GetContentRegionAvail().x, height = font * 6.5f;
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  ImGui::Dummy(ImVec2(width, height));
+  layout::item("sampling.curve");
+  const float left = ImGui::CalcTextSize("0.5").x + font * 0.4f, bottom = font * 1.2f;
+  const ImVec2 p0(origin.x + left, origin.y + font * 0.3f);
+  const ImVec2 p1(origin.x + width - font * 0.5f, origin.y + height - bottom);
+  const float pw = p1.x - p0.x, ph = p1.y - p0.y;
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  dl->AddRectFilled(p0, p1, IM_COL32(20, 20, 24, 255));
+  const ImU32 grid = IM_COL32(60, 60, 70, 255), label = IM_COL32(200, 200, 205, 255);
+  for (const double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const float x = p0.x + static_cast<float>(t) * pw;
+    dl->AddLine(ImVec2(x, p0.y), ImVec2(x, p1.y), grid);
+    const std::string s = tick_label(t);
+    const float tw = ImGui::CalcTextSize(s.c_str()).x;
+    dl->AddText(ImVec2(std::clamp(x - tw * 0.5f, origin.x, origin.x + width - tw), p1.y + 2.0f), label, s.c_str());
+  }
+  for (const double t : {0.0, 0.5, 1.0}) {
+    const float y = p1.y - static_cast<float>(t) * ph;
+    dl->AddLine(ImVec2(p0.x, y), ImVec2(p1.x, y), grid);
+    const std::string s = tick_label(t);
+    dl->AddText(ImVec2(p0.x - ImGui::CalcTextSize(s.c_str()).x - font * 0.2f, y - font * 0.5f), label, s.c_str());
+  }
+  dl->AddRect(p0, p1, IM_COL32(140, 140, 150, 255));
+  const std::size_t n = std::min(c.weight.size(), c.relative_efficiency.size());
+  const auto at = [&](std::size_t i) {
+    return ImVec2(p0.x + c.weight[i] * pw, p1.y - std::clamp(c.relative_efficiency[i], 0.0f, 1.05f) / 1.05f * ph);
+  };
+  const auto heavy = [&](std::size_t i) { return i < c.largest_share.size() && c.largest_share[i] > c.dominant_share; };
+  if (n >= 2) {
+    // Grey over the weights whose prediction one path dominates.
+    const float step = pw / static_cast<float>(n - 1);
+    if (current)
+      for (std::size_t i = 0; i < n; ++i)
+        if (heavy(i)) {
+          const float x = at(i).x;
+          dl->AddRectFilled(ImVec2(std::max(p0.x, x - 0.5f * step), p0.y), ImVec2(std::min(p1.x, x + 0.5f * step), p1.y),
+                            IM_COL32(150, 150, 150, 90));
+        }
+    std::vector<ImVec2> pts;
+    for (std::size_t i = 0; i < n; ++i) pts.push_back(at(i));
+    dl->AddPolyline(pts.data(), static_cast<int>(pts.size()),
+                    current ? IM_COL32(120, 190, 255, 255) : IM_COL32(120, 120, 130, 200), 0, 2.0f);
+    const auto mark = [&](double w, ImU32 colour, float thickness) {
+      if (!(w >= 0.0)) return;
+      const float x = p0.x + static_cast<float>(w) * pw;
+      dl->AddLine(ImVec2(x, p0.y), ImVec2(x, p1.y), colour, thickness);
+    };
+    mark(c.sampling, current ? IM_COL32(230, 230, 230, 200) : IM_COL32(150, 150, 150, 160), 1.0f);
+    mark(c.best, current ? IM_COL32(255, 190, 60, 255) : IM_COL32(170, 150, 110, 200), 2.0f);
+    if (current && ImGui::IsItemHovered()) {
+      const float t = std::clamp((ImGui::GetIO().MousePos.x - p0.x) / pw, 0.0f, 1.0f);
+      const std::size_t i = static_cast<std::size_t>(std::lround(t * static_cast<float>(n - 1)));
       if (heavy(i))
         ImGui::SetTooltip("w = %.2f: %.0f%% of the best, likely too high (one path carries %.0f%% of the moment)",
                           c.weight[i], 100.0f * c.relative_efficiency[i], 100.0f * c.largest_share[i]);
       else
         ImGui::SetTooltip("w = %.2f: %.0f%% of the best", c.weight[i], 100.0f * c.relative_efficiency[i]);
     }
-    // Grey over the weights whose prediction one path dominates, the predicted
-    // best (amber) and the weight the paths came from (white).
-    ImDrawList* dl = ImGui::GetWindowDrawList();
-    bool any_heavy = false;
-    const float step = c.weight.size() > 1 ? width / static_cast<float>(c.weight.size() - 1) : width;
-    for (std::size_t i = 0; i < c.weight.size(); ++i)
-      if (heavy(i)) {
-        any_heavy = true;
-        const float x = p0.x + static_cast<float>(i) * step;
-        dl->AddRectFilled(ImVec2(std::max(p0.x, x - 0.5f * step), p0.y), ImVec2(std::min(p0.x + width, x + 0.5f * step), p0.y + height),
-                          IM_COL32(150, 150, 150, 110));
-      }
-    const auto mark = [&](double w, ImU32 colour, float thickness) {
-      const float x = p0.x + static_cast<float>(w) * width;
-      dl->AddLine(ImVec2(x, p0.y), ImVec2(x, p0.y + height), colour, thickness);
-    };
-    if (c.sampling >= 0.0) mark(c.sampling, IM_COL32(230, 230, 230, 200), 1.0f);
-    if (c.best >= 0.0) mark(c.best, IM_COL32(255, 190, 60, 255), 2.0f);
-    if (any_heavy) {
-      ImGui::TextColored(kDim, "grey: one path dominates, likely too high");
-      if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("There a single path carries more than %.0f%% of the predicted second moment. With a\n"
-                          "finite moment that share falls as paths are added; where it stays large the moment is\n"
-                          "infinite or carried by paths too rare for the samples so far, so the predicted variance\n"
-                          "is too low and the efficiency too high. A render there has the same trouble: its error\n"
-                          "falls slower than 1/N.",
-                          100.0 * static_cast<double>(c.dominant_share));
-    }
-    ImGui::TextColored(kAmber, "predicted best w = %.2f", c.best);
-    ImGui::SameLine();
-    if (ImGui::Button("Use the best weight") && c.best >= 0.0) {
-      s.weights[a] = static_cast<float>(c.best);
-      s.weights[b] = 1.0f - static_cast<float>(c.best);
-    }
-    if (c.fixed_cost_rays >= 0.0) {
-      ImGui::TextColored(kDim, "a sample costs its rays + %.1f rays (%s)", c.fixed_cost_rays,
-                         c.cost_fitted ? "fitted to the passes' times" : "prior");
-      if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("Time per sample = fixed cost + cost per ray x rays. The fixed cost (the camera ray's set-up,\n"
-                          "the film, the pass's bookkeeping) is fitted to auto weight's passes once their rays differ\n"
-                          "enough; until then it is a prior.");
-    }
   }
+  if (!note.empty()) {
+    // Inside the box, so its wording never moves what is below.
+    const ImVec2 size = ImGui::CalcTextSize(note.c_str(), nullptr, false, pw - font);
+    const ImVec2 at_text(p0.x + (pw - size.x) * 0.5f, p0.y + (ph - size.y) * 0.5f);
+    dl->AddRectFilled(ImVec2(at_text.x - 4.0f, at_text.y - 2.0f), ImVec2(at_text.x + size.x + 4.0f, at_text.y + size.y + 2.0f),
+                      IM_COL32(20, 20, 24, 220));
+    dl->AddText(ImGui::GetFont(), font, at_text, IM_COL32(200, 200, 205, 255), note.c_str(), nullptr, pw - font);
+  }
+}
+
+// Beside the w slider, in lines of fixed height whatever the state: the
+// efficiency predicted at every w from the paths drawn so far (the last curve
+// greyed while the next is computed), the predicted best with a button that
+// moves the slider there, the cost model, auto weight and its history, and why
+// the sampling weight keeps away from 0 and 1 while predicting.
+void draw_weight_curve(ViewerSettings& settings, PanelState& state, const UiStatus& status, int a, int b,
+                       UiRequests& requests) {
+  SamplingSettings& s = settings.sampling;
+  const WeightCurveStatus& now = status.weights;
+  const std::array<int, 2> pair{a, b};
+  if (now.active) {
+    state.last_curve = now;
+    state.last_curve_pair = pair;
+  }
+  const bool depth_one = status.max_depth > 0 && status.max_depth <= 1;
+  const bool have_last = state.last_curve_pair == pair && !state.last_curve.weight.empty();
+  const WeightCurveStatus& c = now.active ? now : state.last_curve;
+  const bool shown = !depth_one && (now.active || have_last);
+  const std::string name_a(technique_name(static_cast<Technique>(a))), name_b(technique_name(static_cast<Technique>(b)));
+
+  char title[96];
+  if (depth_one) std::snprintf(title, sizeof title, "Predicted efficiency: none at max depth 1");
+  else if (now.active) std::snprintf(title, sizeof title, "Predicted efficiency (%llu paths)", static_cast<unsigned long long>(now.paths));
+  else std::snprintf(title, sizeof title, "Predicted efficiency against w");
+  // The title gives way to the Export button at the line's end.
+  const float export_w = ImGui::CalcTextSize("Export").x + ImGui::GetStyle().FramePadding.x * 2.0f;
+  one_line(title, kDim, nullptr, export_w + ImGui::GetStyle().ItemSpacing.x);
+  ImGui::SameLine(std::max(0.0f, ImGui::GetWindowContentRegionMax().x - export_w));
+  ImGui::BeginDisabled(!status.can_export_curve);
+  if (ImGui::SmallButton("Export##curve")) requests.export_curve = true;
+  ImGui::EndDisabled();
+  layout::item("sampling.export_curve");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("The predicted curve as SVG and CSV, in the screenshot folder");
+
+  std::string note;
+  if (depth_one) note = "w cannot matter: at max depth 1 no sampled direction is ever followed";
+  else if (!now.active) note = have_last ? "recomputing... (" + now.why + ")" : now.why;
+  weight_curve_plot(shown ? c : WeightCurveStatus{}, now.active && !depth_one, note);
+
+  bool any_heavy = false;
+  for (std::size_t i = 0; i < c.largest_share.size() && shown; ++i) any_heavy = any_heavy || c.largest_share[i] > c.dominant_share;
+  ImGui::TextColored(kDim, "%s", any_heavy ? "grey: one path dominates, likely too high" : " ");
+  if (any_heavy && ImGui::IsItemHovered())
+    ImGui::SetTooltip("There a single path carries more than %.0f%% of the predicted second moment. With a\n"
+                      "finite moment that share falls as paths are added; where it stays large the moment is\n"
+                      "infinite or carried by paths too rare for the samples so far, so the predicted variance\n"
+                      "is too low and the efficiency too high. A render there has the same trouble: its error\n"
+                      "falls slower than 1/N.",
+                      100.0 * static_cast<double>(c.dominant_share));
+  if (shown && c.best >= 0.0) ImGui::TextColored(now.active ? kAmber : kDim, "predicted best w = %.2f", c.best);
+  else ImGui::TextColored(kDim, "predicted best w = -");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!now.active || depth_one || !(now.best >= 0.0));
+  if (ImGui::Button("Use the best weight") && now.best >= 0.0) {
+    s.weights[a] = static_cast<float>(now.best);
+    s.weights[b] = 1.0f - static_cast<float>(now.best);
+  }
+  ImGui::EndDisabled();
+  layout::item("sampling.use_best");
+  if (shown && c.fixed_cost_rays >= 0.0) {
+    ImGui::TextColored(kDim, "a sample costs its rays + %.1f rays (%s)", c.fixed_cost_rays,
+                       c.cost_fitted ? "fitted to the passes' times" : "prior");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("Time per sample = fixed cost + cost per ray x rays. The fixed cost (the camera ray's set-up,\n"
+                        "the film, the pass's bookkeeping) is fitted to auto weight's passes once their rays differ\n"
+                        "enough; until then it is a prior.");
+  } else {
+    ImGui::TextColored(kDim, "a sample costs: not priced yet");
+  }
+  ImGui::BeginDisabled(depth_one);
   ImGui::Checkbox("Auto weight", &settings.auto_weight);
+  ImGui::EndDisabled();
+  layout::item("sampling.auto_weight");
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Between passes (at 16, 32, 64, ... spp) w moves to the best the passes so far predict;\n"
                       "each pass's weight is fixed before it starts, so the accumulated image stays unbiased.");
-  if (!c.history.empty()) {
+  if (settings.auto_weight) {
+    // Its history's line and plot are there while auto weight is on, filled or not.
     ImGui::SameLine();
     std::string h;
-    for (std::size_t i = c.history.size() > 6 ? c.history.size() - 6 : 0; i < c.history.size(); ++i) {
+    for (std::size_t i = now.history.size() > 6 ? now.history.size() - 6 : 0; i < now.history.size(); ++i) {
       char buf[16];
-      std::snprintf(buf, sizeof buf, "%s%.2f", h.empty() ? "" : " > ", c.history[i]);
+      std::snprintf(buf, sizeof buf, "%s%.2f", h.empty() ? "" : " > ", now.history[i]);
       h += buf;
     }
-    ImGui::TextColored(kDim, "w: %s", h.c_str());
-    ImGui::PlotLines("##history", c.history.data(), static_cast<int>(c.history.size()), 0, nullptr, 0.0f, 1.0f,
+    one_line("w: " + (h.empty() ? std::string("-") : h), kDim);
+    ImGui::PlotLines("##history", now.history.data(), static_cast<int>(now.history.size()), 0, nullptr, 0.0f, 1.0f,
                      ImVec2(ImGui::GetContentRegionAvail().x, ImGui::GetFontSize() * 2.5f));
   }
   if (ImGui::TreeNode("Why is w kept inside [0.05, 0.95] while predicting?")) {
@@ -134,45 +238,47 @@ void draw_weight_curve(ViewerSettings& settings, const WeightCurveStatus& c, int
   }
 }
 
-void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
-  SamplingSettings& s = settings.sampling;
-  const SamplingSettings before = s;
-
-  // Combo: each technique alone, then the mixture.
+// The strategy drop-down: each technique alone, then the mixture, then nee-mis
+// with either heuristic.
+void strategy_combo(SamplingSettings& s) {
   std::string current = s.mixture ? "mixture" : std::string(technique_name(s.single));
   if (s.nee_mis) current = s.heuristic == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
-  if (ImGui::BeginCombo("Strategy", current.c_str())) {
-    for (int i = 0; i < kTechniqueCount; ++i) {
-      const auto t = static_cast<Technique>(i);
-      std::string name(technique_name(t));
-      if (!Strategy::single(t).is_unbiased()) name += "   (biased alone)";
-      if (ImGui::Selectable(name.c_str(), !s.nee_mis && !s.mixture && s.single == t)) {
-        s.nee_mis = false;
-        s.mixture = false;
-        s.single = t;
-      }
-    }
-    if (ImGui::Selectable("mixture", !s.nee_mis && s.mixture)) {
+  if (!ImGui::BeginCombo("Strategy", current.c_str())) return;
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    const auto t = static_cast<Technique>(i);
+    std::string name(technique_name(t));
+    // Biased alone at the parameter the panel holds (uniform-cone is not at 90 degrees).
+    Strategy alone = Strategy::single(t);
+    alone.parameters = s.parameters;
+    if (!alone.is_unbiased()) name += "   (biased alone)";
+    if (ImGui::Selectable(name.c_str(), !s.nee_mis && !s.mixture && s.single == t)) {
       s.nee_mis = false;
-      if (!s.mixture) {
-        // Start the mixture from what was shown, so the image does not jump.
-        s.weights = {};
-        s.weights[static_cast<int>(s.single)] = 1.0f;
-      }
-      s.mixture = true;
+      s.mixture = false;
+      s.single = t;
     }
-    ImGui::Separator();
-    for (const MisHeuristic h : {MisHeuristic::Power, MisHeuristic::Balance}) {
-      const char* label = h == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
-      if (ImGui::Selectable(label, s.nee_mis && s.heuristic == h)) {
-        s.nee_mis = true;
-        s.heuristic = h;
-      }
-    }
-    ImGui::EndCombo();
   }
+  if (ImGui::Selectable("mixture", !s.nee_mis && s.mixture)) {
+    s.nee_mis = false;
+    if (!s.mixture) {
+      // Start the mixture from what was shown, so the image does not jump.
+      s.weights = {};
+      s.weights[static_cast<int>(s.single)] = 1.0f;
+    }
+    s.mixture = true;
+  }
+  ImGui::Separator();
+  for (const MisHeuristic h : {MisHeuristic::Power, MisHeuristic::Balance}) {
+    const char* label = h == MisHeuristic::Power ? "nee-mis (power heuristic)" : "nee-mis (balance heuristic)";
+    if (ImGui::Selectable(label, s.nee_mis && s.heuristic == h)) {
+      s.nee_mis = true;
+      s.heuristic = h;
+    }
+  }
+  ImGui::EndCombo();
+}
 
-  // A slider for each parameter a technique in use takes (cosine-power's N).
+// A slider for each parameter a technique in use takes (cosine-power's N).
+void technique_parameters(SamplingSettings& s) {
   for (int i = 0; i < kTechniqueCount && !s.nee_mis; ++i) {
     const TechniqueInfo& t = technique_info(static_cast<Technique>(i));
     const bool used = s.mixture ? s.weights[i] > 0.0f : s.single == static_cast<Technique>(i);
@@ -183,62 +289,72 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
                        ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
     ImGui::PopID();
   }
+}
 
-  if (s.nee_mis) draw_nee_explanation();
-  if (s.mixture && !s.nee_mis) {
-    // The book's two-technique mixture as one number: w * A + (1 - w) * B.
-    state.w_pair = two_technique_pair(s, state.w_pair);
-    if (state.w_pair[0] >= 0) {
-      const int a = state.w_pair[0], b = state.w_pair[1];
-      const float sum = s.weights[a] + s.weights[b];
-      float w = sum > 0.0f ? s.weights[a] / sum : 0.5f;
-      ImGui::TextColored(kDim, "w\xc2\xb7%s + (1-w)\xc2\xb7%s", std::string(technique_name(static_cast<Technique>(a))).c_str(),
-                         std::string(technique_name(static_cast<Technique>(b))).c_str());
-      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-      if (ImGui::SliderFloat("w##pair", &w, 0.0f, 1.0f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
-        s.weights[a] = w;
-        s.weights[b] = 1.0f - w;
-      }
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
-      draw_weight_curve(settings, status.weights, a, b);
-    }
-    const auto norm = s.normalised();
-    ImGui::TextColored(kDim, "weight per technique         fraction");
-    for (int i = 0; i < kTechniqueCount; ++i) {
-      ImGui::PushID(i);
-      ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-      const std::string name(technique_name(static_cast<Technique>(i)));
-      ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.3g").c_str(), ImGuiSliderFlags_AlwaysClamp);
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Raw weight; the renderer normalises. Ctrl+click to type one.");
-      ImGui::SameLine();
-      if (norm[i] > 0.0f) ImGui::Text("%.1f%%", norm[i] * 100.0f);
-      else ImGui::TextColored(kDim, "0%%");
-      ImGui::PopID();
-    }
-    bool any = false;
-    for (float w : s.weights) any = any || w > 0.0f;
-    if (!any) ImGui::TextColored(kRed, "All weights are 0: the image keeps the last valid mixture.");
+// The book's two-technique mixture as one number, w * A + (1 - w) * B, with
+// the predicted curve beside it.
+void pair_weight_slider(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
+  SamplingSettings& s = settings.sampling;
+  state.w_pair = two_technique_pair(s, state.w_pair);
+  if (state.w_pair[0] < 0) return;
+  const int a = state.w_pair[0], b = state.w_pair[1];
+  const float sum = s.weights[a] + s.weights[b];
+  float w = sum > 0.0f ? s.weights[a] / sum : 0.5f;
+  ImGui::TextColored(kDim, "w\xc2\xb7%s + (1-w)\xc2\xb7%s", std::string(technique_name(static_cast<Technique>(a))).c_str(),
+                     std::string(technique_name(static_cast<Technique>(b))).c_str());
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+  if (ImGui::SliderFloat("w##pair", &w, 0.0f, 1.0f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) {
+    s.weights[a] = w;
+    s.weights[b] = 1.0f - w;
   }
+  layout::item("sampling.w");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+click to type an exact value");
+  draw_weight_curve(settings, state, status, a, b, requests);
+}
 
-  // The presets' buttons in a row that wraps where the panel ends.
+// One raw weight slider per technique, each with its fraction of the mixture.
+void mixture_weights(SamplingSettings& s) {
+  const auto norm = s.normalised();
+  ImGui::TextColored(kDim, "weight per technique         fraction");
+  for (int i = 0; i < kTechniqueCount; ++i) {
+    ImGui::PushID(i);
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
+    const std::string name(technique_name(static_cast<Technique>(i)));
+    ImGui::SliderFloat("##w", &s.weights[i], 0.0f, 1.0f, (name + " %.3g").c_str(), ImGuiSliderFlags_AlwaysClamp);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Raw weight; the renderer normalises. Ctrl+click to type one.");
+    ImGui::SameLine();
+    if (norm[i] > 0.0f) ImGui::Text("%.1f%%", norm[i] * 100.0f);
+    else ImGui::TextColored(kDim, "0%%");
+    ImGui::PopID();
+  }
+  // All weights 0: the message line says so (the viewer refuses the mixture).
+}
+
+// The presets in their one place, the section's first row, whatever the
+// strategy: 1-5 as the keys have them, the current one marked. The row wraps
+// where the panel ends, the same way for every strategy.
+void preset_buttons(SamplingSettings& s) {
   const ImGuiStyle& style = ImGui::GetStyle();
   const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
-  const auto flow_button = [&](const char* label, bool first) {
-    const float w = ImGui::CalcTextSize(label).x + style.FramePadding.x * 2.0f;
-    if (!first && ImGui::GetItemRectMax().x + style.ItemSpacing.x + w <= right) ImGui::SameLine();
-    return ImGui::Button(label);
-  };
-  for (int p = 1; p <= kPresetCount; ++p) {
+  const int current = preset_key_of(s);
+  for (int key = 1; key <= kPresetKeyCount; ++key) {
     char label[48];
-    std::snprintf(label, sizeof label, "%d: %s", p, preset_label(static_cast<Preset>(p)));
-    if (flow_button(label, p == 1)) s = preset_sampling(static_cast<Preset>(p));
+    std::snprintf(label, sizeof label, "%d %s", key, preset_key_label(key));
+    const float w = ImGui::CalcTextSize(label).x + style.FramePadding.x * 2.0f;
+    if (key > 1 && ImGui::GetItemRectMax().x + style.ItemSpacing.x + w <= right) ImGui::SameLine();
+    if (key == current) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyleColorVec4(ImGuiCol_ButtonActive));
+    if (ImGui::Button(label)) s = preset_by_key(key);
+    if (key == current) ImGui::PopStyleColor();
+    char name[24];
+    std::snprintf(name, sizeof name, "preset.%d", key);
+    layout::item(name);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("Key %d: %s", key, preset_by_key(key).strategy().to_string().c_str());
   }
-  if (flow_button("4: nee-mis", false)) s = SamplingSettings::from(Strategy::nee());
-  if (flow_button("fastest", false)) s = fastest_sampling();
-  if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("pdflab's most efficient unbiased strategy for general scenes: %s", kFastestStrategy.data());
+}
 
-  // Russian roulette, for any strategy.
+// Russian roulette and the Sobol sampler, for any strategy.
+void path_options(SamplingSettings& s) {
   bool roulette = s.roulette_depth > 0;
   if (ImGui::Checkbox("Russian roulette", &roulette)) s.roulette_depth = roulette ? kDefaultRouletteDepth : 0;
   if (ImGui::IsItemHovered())
@@ -249,50 +365,67 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
     ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
     ImGui::SliderInt("from depth", &s.roulette_depth, 1, 20, "%d", ImGuiSliderFlags_AlwaysClamp);
   }
-  // The stratified sampler, for any strategy.
   ImGui::Checkbox("Sobol sampler", &s.sobol);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Owen-scrambled Sobol points for %s random numbers, stratified\n"
                       "across each pixel's samples (+sobol); off: every number independent",
                       stratified_vertices().c_str());
+}
 
+// The strategy as `pdflab render --strategy` takes it, wrapped before a '+'
+// where it is wider than the panel (fastest's is), never inside a weight; the
+// bias label after it, on the next line if it does not fit.
+void strategy_line(const SamplingSettings& s) {
   const Strategy strategy = s.strategy();
   bool any = strategy.nee_mis;
   for (float w : strategy.weights) any = any || w > 0.0f;
-  if (any) {
-    // Wrapped before a '+' where it is wider than the panel (fastest's is), never
-    // inside a weight; the bias label after it, on the next line if it does not fit.
-    const std::string text = strategy.to_string();
-    const float line_end = ImGui::GetCursorScreenPos().x + ImGui::GetContentRegionAvail().x;
-    const auto same_line_if_fits = [&](const char* next, float spacing) {
-      ImGui::SameLine(0.0f, spacing);
-      if (ImGui::GetCursorScreenPos().x + ImGui::CalcTextSize(next).x > line_end) ImGui::NewLine();
-    };
-    bool hovered = false;
-    for (std::size_t begin = 0; begin < text.size();) {
-      const std::size_t end = std::min(text.find('+', begin + 1), text.size());
-      const std::string piece = text.substr(begin, end - begin);
-      if (begin > 0) same_line_if_fits(piece.c_str(), 0.0f);
-      ImGui::TextUnformatted(piece.c_str());
-      hovered = hovered || ImGui::IsItemHovered();
-      begin = end;
-    }
-    if (hovered) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
-    same_line_if_fits(strategy.is_unbiased() ? "unbiased" : "BIASED", ImGui::GetStyle().ItemSpacing.x);
-    if (strategy.is_unbiased()) {
-      ImGui::TextColored(kGreen, "unbiased");
-    } else {
-      ImGui::TextColored(kRed, "BIASED");
-      ImGui::PushStyleColor(ImGuiCol_Text, kRed);
-      ImGui::TextWrapped("Its pdf is zero away from the importance targets, so indirect light is missing.");
-      ImGui::PopStyleColor();
-    }
+  if (!any) return;
+  const std::string text = strategy.to_string();
+  const float line_end = ImGui::GetCursorScreenPos().x + ImGui::GetContentRegionAvail().x;
+  const auto same_line_if_fits = [&](const char* next, float spacing) {
+    ImGui::SameLine(0.0f, spacing);
+    if (ImGui::GetCursorScreenPos().x + ImGui::CalcTextSize(next).x > line_end) ImGui::NewLine();
+  };
+  bool hovered = false;
+  for (std::size_t begin = 0; begin < text.size();) {
+    const std::size_t end = std::min(text.find('+', begin + 1), text.size());
+    const std::string piece = text.substr(begin, end - begin);
+    if (begin > 0) same_line_if_fits(piece.c_str(), 0.0f);
+    ImGui::TextUnformatted(piece.c_str());
+    hovered = hovered || ImGui::IsItemHovered();
+    begin = end;
   }
-  if (!status.settings_error.empty()) {
+  if (hovered) ImGui::SetTooltip("The same strategy for `pdflab render --strategy`");
+  same_line_if_fits(strategy.is_unbiased() ? "unbiased" : "BIASED", ImGui::GetStyle().ItemSpacing.x);
+  if (strategy.is_unbiased()) {
+    ImGui::TextColored(kGreen, "unbiased");
+  } else {
+    ImGui::TextColored(kRed, "BIASED");
     ImGui::PushStyleColor(ImGuiCol_Text, kRed);
-    ImGui::TextWrapped("%s", status.settings_error.c_str());
+    ImGui::TextWrapped("%s: its pdf is zero where light may arrive, which it then never sees.",
+                       strategy.bias_reason().c_str());
     ImGui::PopStyleColor();
   }
+}
+
+// The Sampling section, in the order it reads: the presets, the strategy, its
+// parameters, its weights, the path options, the strategy as text; any edit
+// restarts the render.
+void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatus& status, UiRequests& requests) {
+  SamplingSettings& s = settings.sampling;
+  const SamplingSettings before = s;
+  preset_buttons(s);
+  strategy_combo(s);
+  layout::item("sampling.strategy");
+  technique_parameters(s);
+  if (s.nee_mis) draw_nee_explanation(s);
+  if (s.mixture && !s.nee_mis) {
+    pair_weight_slider(settings, state, status, requests);
+    mixture_weights(s);
+  }
+  path_options(s);
+  strategy_line(s);
+  // A refused strategy is said on the panel's message line, which moves nothing.
   if (!(s == before)) requests.restart_render = true;
 }
 
@@ -309,36 +442,41 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
     }
     ImGui::EndCombo();
   }
+  layout::item("scene.combo");
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - ImGui::CalcTextSize("Load").x -
                           ImGui::GetStyle().FramePadding.x * 2.0f - ImGui::GetStyle().ItemSpacing.x);
   const bool entered = ImGui::InputTextWithHint("##path", "scene file path", &state.scene_path_field,
                                                 ImGuiInputTextFlags_EnterReturnsTrue);
+  layout::item("scene.path");
   ImGui::SameLine();
   if ((ImGui::Button("Load") || entered) && !state.scene_path_field.empty()) requests.load_scene = state.scene_path_field;
+  layout::item("scene.load");
+  // A refused file is said on the message line (and the current scene goes on rendering).
   ImGui::TextColored(kDim, "%s, %dx%d", status.scene_name.c_str(), status.width, status.height);
-  if (!status.scene_error.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, kRed);
-    ImGui::TextWrapped("%s", status.scene_error.c_str());
-    ImGui::PopStyleColor();
-  }
 
   ImGui::Spacing();
   if (ImGui::SliderInt("Max depth", &settings.max_depth, 1, 100, "%d", ImGuiSliderFlags_AlwaysClamp))
     requests.restart_render = true;
+  layout::item("scene.depth");
   const std::uint64_t step = 1;
   if (ImGui::InputScalar("Seed", ImGuiDataType_U64, &settings.seed, &step)) requests.restart_render = true;
+  layout::item("scene.seed");
 
-  char current[48];
-  std::snprintf(current, sizeof current, "%.0f%%  (%dx%d)", settings.resolution_scale * 100.0, status.width,
-                status.height);
+  // At a size set to match a reference the combo says that size, not a scale it is not.
+  char current[64];
+  if (settings.width_override > 0 && settings.height_override > 0)
+    std::snprintf(current, sizeof current, "%dx%d (the reference's)", status.width, status.height);
+  else
+    std::snprintf(current, sizeof current, "%.0f%%  (%dx%d)", settings.resolution_scale * 100.0, status.width,
+                  status.height);
   if (ImGui::BeginCombo("Resolution", current)) {
     for (float scale : kResolutionScales) {
       char label[48];
       std::snprintf(label, sizeof label, "%.0f%%  (%dx%d)", scale * 100.0,
                     std::max(1, static_cast<int>(static_cast<float>(status.base_width) * scale + 0.5f)),
                     std::max(1, static_cast<int>(static_cast<float>(status.base_height) * scale + 0.5f)));
-      if (ImGui::Selectable(label, scale == settings.resolution_scale) &&
-          (scale != settings.resolution_scale || settings.width_override > 0)) {
+      const bool is_current = scale == settings.resolution_scale && settings.width_override == 0;
+      if (ImGui::Selectable(label, is_current) && !is_current) {
         settings.resolution_scale = scale;
         settings.width_override = settings.height_override = 0;
         requests.restart_render = true;
@@ -346,24 +484,38 @@ void scene_section(ViewerSettings& settings, PanelState& state, const UiStatus& 
     }
     ImGui::EndCombo();
   }
+  layout::item("scene.resolution");
 
   const std::uint32_t spp_step = 16;
   if (ImGui::InputScalar("Stop at spp", ImGuiDataType_U32, &settings.stop_spp, &spp_step))
     requests.stop_changed = true;
+  layout::item("scene.stop_spp");
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("0: never stop. Changing it does not restart.");
+  if (ImGui::InputFloat("Stop at seconds", &settings.stop_seconds, 5.0f, 60.0f, "%.0f s")) {
+    settings.stop_seconds = std::clamp(settings.stop_seconds, 0.0f, 1e6f);
+    requests.stop_changed = true;
+  }
+  layout::item("scene.stop_seconds");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("0: no time limit. The render stops at the first pass boundary after this much\n"
+                      "rendering time (pauses not counted); whichever stop comes first ends it.");
 
   if (ImGui::Button(settings.paused ? "Resume (Space)" : "Pause (Space)")) {
     settings.paused = !settings.paused;
     requests.pause_changed = true;
   }
+  layout::item("scene.pause");
   ImGui::SameLine();
   if (ImGui::Button("Restart (R)")) requests.restart_render = true;
+  layout::item("scene.restart");
   if (ImGui::Button(status.camera_mode ? "Leave camera mode (O)" : "Camera mode (O)")) requests.toggle_camera_mode = true;
+  layout::item("scene.camera");
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Drag orbits, right-drag pans, the wheel dollies");
   ImGui::SameLine();
   ImGui::BeginDisabled(!status.camera_moved);
   if (ImGui::Button("Reset camera (Home)")) requests.reset_camera = true;
   ImGui::EndDisabled();
+  layout::item("scene.reset_camera");
 }
 
 void display_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
@@ -375,6 +527,7 @@ void display_section(ViewerSettings& settings, const UiStatus& status, UiRequest
   ImGui::RadioButton("sRGB", &transfer, 1);
   settings.srgb = transfer == 1;
   draw_view_mode_selector(settings);
+  layout::item("display.view");
   draw_layer_controls(settings, status.measure);
   char scale[16];
   std::snprintf(scale, sizeof scale, "%.0f%%", settings.ui_scale * 100.0f);
@@ -385,10 +538,15 @@ void display_section(ViewerSettings& settings, const UiStatus& status, UiRequest
     }
     ImGui::EndCombo();
   }
+  layout::item("display.ui_scale");
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Larger text for a projector (also: pdflab --ui-scale 1.5)");
   if (ImGui::Button("Presentation mode (F11)")) requests.toggle_presentation = true;
+  layout::item("display.presentation");
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Full screen, the image alone: no panel, badges or inspector. F11 or Esc leaves.");
+  ImGui::Checkbox("Caption in presentation mode", &settings.caption);
+  layout::item("display.caption");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("A line under the image for the class: strategy, spp, time");
 }
 
 // In the split the main render rests: the two sides are what runs.
@@ -470,53 +628,204 @@ void statistics_section(const ViewerSettings& settings, const UiStatus& status) 
 
 void screenshot_section(ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
   ImGui::InputText("Folder", &settings.screenshot_dir);
+  layout::item("shots.folder");
   ImGui::BeginDisabled(status.screenshot_pending);
   if (ImGui::Button(status.screenshot_pending ? "Saving..." : "Save screenshot (F12)")) requests.screenshot = true;
   ImGui::EndDisabled();
+  layout::item("shots.screenshot");
+  ImGui::SameLine();
   if (status.can_retry_screenshot) {
-    ImGui::SameLine();
     if (ImGui::Button("Retry save")) requests.retry_screenshot = true;
+  } else if (ImGui::Button("Save film (Ctrl+S)")) {
+    requests.save_film = true;
   }
-  if (!status.notice.text.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, status.notice.error ? kRed : kGreen);
-    ImGui::TextWrapped("%s", status.notice.text.c_str());
-    ImGui::PopStyleColor();
+  layout::item("shots.film");
+  ImGui::TextColored(kDim, "Figures of what is shown, for a report:");
+  ImGui::BeginDisabled(!status.can_export_view);
+  if (ImGui::Button("View as PNG (Ctrl+E)")) requests.export_view = true;
+  ImGui::EndDisabled();
+  layout::item("export.view");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("The heat map, difference, best-weight or technique-share view as a PNG\n"
+                      "with its colour bar and a caption (V picks the view)");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!status.can_export_curve);
+  if (ImGui::Button("Curve")) requests.export_curve = true;
+  ImGui::EndDisabled();
+  layout::item("export.curve");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("The predicted efficiency against w as SVG and CSV");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!status.can_export_convergence);
+  if (ImGui::Button("Convergence")) requests.export_convergence = true;
+  ImGui::EndDisabled();
+  layout::item("export.convergence");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("The convergence plot's curves (pins and the running one) as SVG and CSV");
+  // Saves and exports report on the message line (and over the image).
+}
+
+// The panel's head, which never scrolls: where the render stands, its headline
+// figure (measured, rough or estimated) and the message line, all one line
+// each, so nothing below moves when they change.
+void summary_header(const ViewerSettings& settings, const UiStatus& status, UiRequests& requests) {
+  const SessionStats& st = status.stats;
+  char line[160];
+  if (status.split) {
+    std::snprintf(line, sizeof line, "split: A %u spp, B %u spp", status.split->a.spp, status.split->b.spp);
+  } else {
+    std::snprintf(line, sizeof line, "%u spp   %s   %.2f M samples/s%s", st.spp, format_seconds(st.seconds).c_str(),
+                  st.samples_per_second * 1e-6, st.done ? "   done" : (st.paused || settings.paused ? "   paused" : ""));
   }
+  one_line(line, ImVec4(0.92f, 0.92f, 0.95f, 1.0f));
+  layout::item("summary.render");
+  // Hide the panel: the button at the head's right end.
+  const float hide_w = ImGui::CalcTextSize(">>").x + ImGui::GetStyle().FramePadding.x * 2.0f;
+  ImGui::SameLine(std::max(0.0f, ImGui::GetWindowContentRegionMax().x - hide_w));
+  if (ImGui::SmallButton(">>")) requests.toggle_panel = true;
+  layout::item("panel.hide");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Hide the panel (Tab); drag its left edge to resize it");
+
+  const Figures* f = status.measure ? &status.measure->figures : nullptr;
+  if (!f || !f->valid) {
+    one_line("figures after the first full pass", kDim);
+  } else if (f->against_reference && f->rough_reference) {
+    std::snprintf(line, sizeof line, "relMSE %.3g ROUGH: the reference's noise is %.0f%% of it", f->relmse,
+                  100.0 * f->reference_share);
+    one_line(line, kAmber);
+  } else if (f->against_reference) {
+    std::snprintf(line, sizeof line, "relMSE %.3g +- %.2g measured, efficiency %.3g", f->relmse, f->relmse_interval,
+                  f->efficiency);
+    one_line(line, kGreen);
+  } else {
+    if (f->unbiased)
+      std::snprintf(line, sizeof line, "relMSE %.3g estimated, efficiency %.3g est.%s", f->estimated_relmse,
+                    f->estimated_efficiency, f->estimate_unreliable ? ", unreliable" : "");
+    else
+      std::snprintf(line, sizeof line, "relMSE %.3g estimated (biased: no efficiency)", f->estimated_relmse);
+    one_line(line, kAmber);
+  }
+  layout::item("summary.figures");
+
+  // The message line: the most pressing message, all of them in its tooltip.
+  if (status.messages.empty()) {
+    one_line("H: keys and help   Tab: hide the panel", kDim);
+  } else {
+    const PanelMessage& m = status.messages.front();
+    std::string all;
+    for (std::size_t i = 1; i < status.messages.size(); ++i) all += (all.empty() ? "" : "\n") + status.messages[i].text;
+    one_line(m.text, m.kind == PanelMessage::Error ? kRed : (m.kind == PanelMessage::Warning ? kAmber : kGreen),
+             all.empty() ? nullptr : all.c_str());
+  }
+  layout::item("summary.message");
+  ImGui::Separator();
 }
 
 }  // namespace
 
-void draw_side_panel(float width, float display_height, ViewerSettings& settings, PanelState& state,
-                     const UiStatus& status, UiRequests& requests) {
+void draw_side_panel(const Box& box, ViewerSettings& settings, PanelState& state, const UiStatus& status,
+                     UiRequests& requests) {
   if (!state.scene_field_initialised) {
     state.scene_path_field = status.scene_path;
     state.scene_field_initialised = true;
   }
-  const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x - width, vp->Pos.y));
-  ImGui::SetNextWindowSize(ImVec2(width, display_height));
+  ImGui::SetNextWindowPos(ImVec2(box.x, box.y));
+  ImGui::SetNextWindowSize(ImVec2(box.w, box.h));
   // Behind every other window, always: it is the background the views open over.
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoTitleBar |
-                                 ImGuiWindowFlags_NoBringToFrontOnFocus;
+                                 ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoScrollbar |
+                                 ImGuiWindowFlags_NoScrollWithMouse;
   // The viewer clears the panel's rectangle itself (kPanelBackground): a
   // full-height filled quad is the costliest thing ImGui draws on a software
   // rasteriser, a clear costs next to nothing.
   ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.0f, 0.0f, 0.0f, 0.0f));
   ImGui::Begin("pdflab", nullptr, flags);
   ImGui::PopStyleColor();
+  layout::region("panel", box);
+  summary_header(settings, status, requests);
+  // The sections scroll under the head.
+  ImGui::PushStyleColor(ImGuiCol_ChildBg, ImVec4(0.0f, 0.0f, 0.0f, 0.0f));
+  ImGui::BeginChild("##sections", ImVec2(0.0f, 0.0f), false);
+  ImGui::PopStyleColor();
+  layout::region("panel.sections", {ImGui::GetWindowPos().x, ImGui::GetWindowPos().y, ImGui::GetWindowSize().x,
+                                    ImGui::GetWindowSize().y});
   ImGui::PushItemWidth(ImGui::GetContentRegionAvail().x * 0.62f);
-  if (ImGui::CollapsingHeader("Sampling", ImGuiTreeNodeFlags_DefaultOpen)) sampling_section(settings, state, status, requests);
-  if (ImGui::CollapsingHeader("Scene and render", ImGuiTreeNodeFlags_DefaultOpen))
-    scene_section(settings, state, status, requests);
-  if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics_section(settings, status);
-  if (ImGui::CollapsingHeader("Measure", ImGuiTreeNodeFlags_DefaultOpen)) draw_measure_section(settings, status, requests);
-  if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) display_section(settings, status, requests);
-  if (ImGui::CollapsingHeader("Screenshot", ImGuiTreeNodeFlags_DefaultOpen))
-    screenshot_section(settings, status, requests);
+  for (int i = 0; i < kPanelSectionCount; ++i) {
+    ImGui::SetNextItemOpen(state.open[static_cast<std::size_t>(i)], ImGuiCond_Always);
+    const bool open = ImGui::CollapsingHeader(kPanelSections[static_cast<std::size_t>(i)]);
+    state.open[static_cast<std::size_t>(i)] = open;
+    char name[32];
+    std::snprintf(name, sizeof name, "section.%d", i);
+    layout::item(name);
+    if (!open) continue;
+    switch (i) {
+      case 0: sampling_section(settings, state, status, requests); break;
+      case 1: scene_section(settings, state, status, requests); break;
+      case 2: statistics_section(settings, status); break;
+      case 3: draw_measure_section(settings, status, requests); break;
+      case 4: display_section(settings, status, requests); break;
+      default: screenshot_section(settings, status, requests); break;
+    }
+  }
   ImGui::PopItemWidth();
   ImGui::Spacing();
   if (ImGui::Button("Help (H)")) state.show_help = !state.show_help;
+  layout::item("panel.help");
+  ImGui::EndChild();
+  ImGui::End();
+}
+
+float draw_panel_edge(const Box& panel, float scale, float window_width, ViewerSettings& settings) {
+  // A strip over the panel's left edge: drag to resize, double-click for the default width.
+  const float grip = std::max(6.0f, 4.0f * scale);
+  ImGui::SetNextWindowPos(ImVec2(panel.x - grip * 0.5f, panel.y));
+  ImGui::SetNextWindowSize(ImVec2(grip, panel.h));
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                                 ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav;
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0.0f, 0.0f));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1.0f, 1.0f));  // the grip's width, not ImGui's smallest window
+  ImGui::Begin("##panel edge", nullptr, flags);
+  ImGui::PopStyleVar(2);
+  ImGui::InvisibleButton("##splitter", ImVec2(grip, panel.h));
+  layout::item("panel.splitter");
+  const bool active = ImGui::IsItemActive(), hovered = ImGui::IsItemHovered();
+  if (active || hovered) ImGui::SetMouseCursor(ImGuiMouseCursor_ResizeEW);
+  if (hovered && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) settings.panel_width = kDefaultPanelWidth;
+  float width = panel.w;
+  if (active) {
+    const float right = panel.x + panel.w;
+    width = std::clamp(right - ImGui::GetIO().MousePos.x, kMinPanelWidth * scale, kMaxPanelShare * window_width);
+    settings.panel_width = width / scale;
+  }
+  const float x = panel.x;
+  ImGui::GetWindowDrawList()->AddLine(ImVec2(x, panel.y), ImVec2(x, panel.y + panel.h),
+                                      active ? IM_COL32(255, 200, 90, 255)
+                                             : (hovered ? IM_COL32(200, 200, 210, 255) : IM_COL32(70, 70, 80, 255)),
+                                      active || hovered ? 3.0f : 1.0f);
+  ImGui::End();
+  return width;
+}
+
+void draw_panel_tab(UiRequests& requests) {
+  // While the panel is hidden: a small tab at the top right to bring it back,
+  // placed first among the boxes over the image.
+  layout::Overlay o;
+  o.corner = Corner::TopRight;
+  o.width = ImGui::CalcTextSize("<< panel").x + 2.0f * (ImGui::GetStyle().FramePadding.x + ImGui::GetStyle().WindowPadding.x);
+  o.height = ImGui::GetFrameHeight() + 2.0f * ImGui::GetStyle().WindowPadding.y;
+  o.min_width = 4.0f;
+  if (!layout::place_next_window("##panel tab", o)) return;
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
+  if (ImGui::Begin("##panel tab", nullptr, flags)) {
+    if (ImGui::SmallButton("<< panel")) requests.toggle_panel = true;
+    layout::item("panel.show");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Show the panel (Tab)");
+  }
   ImGui::End();
 }
 
@@ -524,22 +833,32 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
   if (!state.show_help) return;
   ImGui::SetNextWindowPos(ImVec2(area_width * 0.5f, area_height * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowBgAlpha(0.9f);
+  // Never taller than the window: it scrolls instead.
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), ImVec2(std::max(200.0f, area_width - 20.0f),
+                                                                  std::max(200.0f, area_height - 20.0f)));
   const ImGuiWindowFlags flags = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse;
   if (ImGui::Begin("Keys", &state.show_help, flags)) {
-    static constexpr const char* kKeys[][2] = {
+    std::string views;
+    for (int i = 0; i < kViewModeCount; ++i)
+      views += std::string(i ? ", " : "") + view_mode_label(static_cast<ViewMode>(i));
+    const std::string view_line = "next view: " + views;
+    const std::string keys[][2] = {
         {"Space", "pause / resume"},
         {"R", "restart the accumulation"},
         {"1", "preset: cosine only"},
         {"2", "preset: light only"},
         {"3", "preset: book 50/50 (cosine + light)"},
         {"4", "next-event estimation (nee-mis)"},
-        {"V", "next view: image, noise heat map, difference, drops"},
+        {"5", "fastest (nee-mis with a mixture, Sobol, roulette)"},
+        {"V", view_line},
         {"E, Shift+E", "next, previous error metric of the heat map or difference view"},
         {"G", "show / hide the convergence plot (graph)"},
         {"K", "keep (pin) the running convergence curve"},
         {"M", "make a reference (Measure section; M again cancels)"},
         {"F12", "screenshot: PNG + PFM + JSON"},
+        {"Ctrl+S", "save the film (continue it with --resume)"},
+        {"Ctrl+E", "export the view as a PNG figure with its legend"},
         {"S", "split screen A/B: two strategies, equal time"},
         {"P", "pixel probe: click a pixel (C: chi-square)"},
         {"L", "1D lab: f, p, inverse CDF, pi"},
@@ -547,6 +866,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"drag", "pan (right or middle button; left outside probe mode)"},
         {"Z, F", "one image pixel per screen pixel; fit the window"},
         {"Ctrl+C", "copy the pixel inspector's values"},
+        {"Tab", "hide / show the side panel (drag its edge to resize)"},
         {"F11", "presentation mode: full screen, the image alone"},
         {"O", "camera mode: drag orbits, right-drag pans, wheel dollies"},
         {"Home", "back to the scene's camera"},
@@ -554,102 +874,121 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"Esc", "close a drop-down, cancel an edit, leave probe mode"},
         {"Ctrl+Q", "quit (asks first when a render is unsaved)"},
     };
-    for (const auto& k : kKeys) {
-      ImGui::TextColored(kAmber, "%s", k[0]);
-      ImGui::SameLine(ImGui::GetFontSize() * 5.0f);
-      ImGui::TextUnformatted(k[1]);
+    const float column = ImGui::GetFontSize() * 6.0f;
+    ImGui::PushTextWrapPos(std::min(ImGui::GetFontSize() * 34.0f, area_width - 40.0f));
+    for (const auto& k : keys) {
+      ImGui::TextColored(kAmber, "%s", k[0].c_str());
+      ImGui::SameLine(column);
+      ImGui::TextWrapped("%s", k[1].c_str());
     }
     ImGui::Separator();
-    ImGui::TextColored(kDim, "Any change to sampling, scene or render settings\nrestarts the accumulation at once.");
-  }
-  ImGui::End();
-}
-
-ImVec2 draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
-  std::string text;
-  if (status.showing_preview) text = "preview";
-  else if (settings.paused) text = "paused";
-  if (!settings.sampling.strategy().is_unbiased()) text += text.empty() ? "biased strategy" : "  |  biased strategy";
-  if (text.empty()) return ImVec2(0.0f, 0.0f);
-  const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + 8.0f, vp->Pos.y + 8.0f));
-  ImGui::SetNextWindowBgAlpha(0.6f);
-  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
-                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
-  ImVec2 corner(0.0f, 0.0f);
-  if (ImGui::Begin("##badges", nullptr, flags)) {
-    ImGui::TextColored(kAmber, "%s", text.c_str());
-    // The window's size settles on its first frame; the text's own extent is
-    // known at once.
-    const ImVec2 pad = ImGui::GetStyle().WindowPadding;
-    corner = ImVec2(ImGui::GetItemRectMax().x + pad.x, ImGui::GetItemRectMax().y + pad.y);
-  }
-  ImGui::End();
-  return corner;
-}
-
-void draw_hint(const char* text) {
-  const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x * 0.5f, vp->Pos.y + 12.0f), ImGuiCond_Always, ImVec2(0.5f, 0.0f));
-  ImGui::SetNextWindowBgAlpha(0.7f);
-  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
-                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
-  if (ImGui::Begin("##hint", nullptr, flags)) ImGui::TextColored(kAmber, "%s", text);
-  ImGui::End();
-}
-
-void draw_notice_toast(const Notice& notice, float area_width, float area_height) {
-  ImGui::SetNextWindowPos(ImVec2(area_width * 0.5f, area_height - 12.0f), ImGuiCond_Always, ImVec2(0.5f, 1.0f));
-  ImGui::SetNextWindowBgAlpha(0.85f);
-  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
-                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
-  if (ImGui::Begin("##notice", nullptr, flags)) {
-    ImGui::PushTextWrapPos(std::max(ImGui::GetFontSize() * 10.0f, area_width - 40.0f));
-    ImGui::TextColored(notice.error ? kRed : kGreen, "%s", notice.text.c_str());
+    ImGui::TextWrapped("Keys do nothing while a text field is being edited. Any change to sampling, scene or render "
+                       "settings restarts the accumulation at once.");
     ImGui::PopTextWrapPos();
   }
   ImGui::End();
 }
 
-QuitChoice draw_quit_dialog(double unsaved_seconds, bool saving, const Notice& notice) {
-  const ImGuiViewport* vp = ImGui::GetMainViewport();
-  // A dimmed cover that takes every click, then the question on top of it.
-  ImGui::SetNextWindowPos(vp->Pos);
-  ImGui::SetNextWindowSize(vp->Size);
-  ImGui::SetNextWindowFocus();
-  ImGui::SetNextWindowBgAlpha(0.55f);
-  const ImGuiWindowFlags cover = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoNav;
-  ImGui::Begin("##quit cover", nullptr, cover);
-  ImGui::End();
-  QuitChoice choice = QuitChoice::None;
-  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x * 0.5f, vp->Pos.y + vp->Size.y * 0.5f), ImGuiCond_Always,
-                          ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowFocus();
-  ImGui::SetNextWindowBgAlpha(1.0f);
-  const ImGuiWindowFlags dialog = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
-                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse;
-  if (ImGui::Begin("Quit pdflab?", nullptr, dialog)) {
-    ImGui::Text("This render has run %.0f s since it was last saved;", unsaved_seconds);
-    ImGui::Text("quitting loses it.");
-    if (notice.error && !notice.text.empty()) {
-      ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);
-      ImGui::TextColored(kRed, "%s", notice.text.c_str());
-      ImGui::PopTextWrapPos();
+namespace {
+
+constexpr ImGuiWindowFlags kOverlayFlags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                           ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                           ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs;
+
+// A one-box overlay of text lines in `corner`; false when there was no room.
+bool text_overlay(const char* name, Corner corner, const std::vector<std::pair<std::string, ImVec4>>& lines,
+                  float alpha) {
+  float natural = 0.0f;
+  for (const auto& [text, colour] : lines) natural = std::max(natural, ImGui::CalcTextSize(text.c_str()).x);
+  float wrap = 0.0f;
+  layout::Overlay o;
+  o.corner = corner;
+  o.width = natural + 2.0f * ImGui::GetStyle().WindowPadding.x;
+  o.height = layout::text_height(static_cast<int>(lines.size()));
+  o.min_width = 6.0f;
+  if (!layout::place_next_window(name, o, &wrap)) return false;
+  ImGui::SetNextWindowBgAlpha(alpha);
+  if (ImGui::Begin(name, nullptr, kOverlayFlags)) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + wrap);
+    for (const auto& [text, colour] : lines) {
+      ImGui::PushStyleColor(ImGuiCol_Text, colour);
+      ImGui::TextWrapped("%s", text.c_str());
+      ImGui::PopStyleColor();
     }
-    ImGui::Spacing();
-    ImGui::BeginDisabled(saving);
-    if (ImGui::Button(saving ? "Saving..." : "Save screenshot, then quit")) choice = QuitChoice::SaveAndQuit;
-    ImGui::EndDisabled();
-    ImGui::SameLine();
-    if (ImGui::Button("Quit anyway (Ctrl+Q)")) choice = QuitChoice::Quit;
-    ImGui::SameLine();
-    if (ImGui::Button("Cancel (Esc)")) choice = QuitChoice::Cancel;
+    ImGui::PopTextWrapPos();
   }
   ImGui::End();
+  return true;
+}
+
+}  // namespace
+
+void draw_image_badges(const ViewerSettings& settings, const UiStatus& status) {
+  std::string text;
+  if (status.showing_preview) text = "preview";
+  else if (settings.paused) text = "paused";
+  else if (status.stats.done) text = "done";
+  const Strategy strategy = settings.sampling.strategy();
+  if (!strategy.is_unbiased())
+    text += (text.empty() ? "biased: " : "  |  biased: ") + strategy.bias_reason();
+  if (text.empty()) return;
+  text_overlay("##badges", Corner::TopLeft, {{text, kAmber}}, 0.6f);
+}
+
+void draw_hint(const char* text) { text_overlay("##hint", Corner::TopLeft, {{text, kAmber}}, 0.7f); }
+
+void draw_notice_toast(const Notice& notice) {
+  text_overlay("##notice", Corner::BottomRight, {{notice.text, notice.error ? kRed : kGreen}}, 0.85f);
+}
+
+void draw_caption(const ViewerSettings& settings, const UiStatus& status) {
+  const SessionStats& st = status.stats;
+  char line[96];
+  std::snprintf(line, sizeof line, "%u spp   %s", st.spp, format_seconds(st.seconds).c_str());
+  text_overlay("##caption", Corner::BottomLeft,
+               {{settings.sampling.strategy().to_string(), ImVec4(1.0f, 1.0f, 1.0f, 1.0f)},
+                {line, ImVec4(0.85f, 0.85f, 0.88f, 1.0f)}},
+               0.7f);
+}
+
+QuitChoice draw_quit_dialog(bool asking, double unsaved_seconds, bool saving, const Notice& notice) {
+  // A modal popup: ImGui dims the rest and lets nothing else take the mouse,
+  // and its buttons keep the clicks they get (a window focused anew every
+  // frame would drop a press before its release).
+  constexpr const char* kTitle = "Quit pdflab?";
+  if (asking && !ImGui::IsPopupOpen(kTitle)) ImGui::OpenPopup(kTitle);
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->Pos.x + vp->Size.x * 0.5f, vp->Pos.y + vp->Size.y * 0.5f), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  QuitChoice choice = QuitChoice::None;
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse;
+  if (!ImGui::BeginPopupModal(kTitle, nullptr, flags)) return choice;
+  if (!asking) {
+    ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+    return choice;
+  }
+  ImGui::Text("This render has run %.0f s since it was last saved;", unsaved_seconds);
+  ImGui::Text("quitting loses it.");
+  if (notice.error && !notice.text.empty()) {
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);
+    ImGui::TextColored(kRed, "%s", notice.text.c_str());
+    ImGui::PopTextWrapPos();
+  }
+  ImGui::Spacing();
+  ImGui::BeginDisabled(saving);
+  if (ImGui::Button(saving ? "Saving..." : "Save screenshot, then quit")) choice = QuitChoice::SaveAndQuit;
+  ImGui::EndDisabled();
+  layout::item("quit.save");
+  ImGui::SameLine();
+  if (ImGui::Button("Quit anyway (Ctrl+Q)")) choice = QuitChoice::Quit;
+  layout::item("quit.quit");
+  ImGui::SameLine();
+  if (ImGui::Button("Cancel (Esc)")) choice = QuitChoice::Cancel;
+  layout::item("quit.cancel");
+  if (choice == QuitChoice::Cancel || choice == QuitChoice::Quit) ImGui::CloseCurrentPopup();
+  ImGui::EndPopup();
   return choice;
 }
 

@@ -57,6 +57,40 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
                  {"vup", vec(d.camera.vup)},
                  {"vfov", d.camera.vfov_degrees},
                  {"moved", d.camera_moved}};
+  if (!d.scene_hash.empty()) j["scene_hash"] = d.scene_hash;
+  // The figures the viewer showed, and the reference behind them: a report
+  // quotes them with what they were measured against.
+  const Figures& f = d.figures;
+  nlohmann::json figures;
+  figures["source"] = !f.valid ? "none" : (f.against_reference ? (f.rough_reference ? "rough" : "measured") : "estimated");
+  if (f.valid) {
+    if (!f.estimate_why.empty()) figures["why_estimated"] = f.estimate_why;
+    figures["spp"] = f.spp;
+    figures["seconds"] = f.seconds;
+    if (f.against_reference) {
+      figures["relmse"] = f.relmse;
+      figures["relmse_interval"] = f.relmse_interval;
+      figures["relmse_raw"] = f.relmse_raw;
+      if (f.reference_corrected) figures["reference_share"] = f.reference_share;
+      figures["efficiency"] = f.efficiency;
+      figures["rmse"] = f.rmse;
+    }
+    figures["estimated_relmse"] = f.estimated_relmse;
+    if (f.unbiased) figures["estimated_efficiency"] = f.estimated_efficiency;
+    figures["mean_relative_standard_error"] = f.mean_relative_standard_error;
+    figures["estimate_unreliable"] = f.estimate_unreliable;
+  }
+  j["figures"] = figures;
+  if (d.reference.loaded) {
+    const ScreenshotData::ReferenceFacts& r = d.reference;
+    j["reference"] = {{"path", r.path},       {"from_cache", r.from_cache}, {"strategy", r.strategy},
+                      {"scene_hash", r.scene_hash}, {"width", r.width},   {"height", r.height},
+                      {"max_depth", r.max_depth}, {"spp", r.spp},         {"seconds", r.seconds},
+                      {"matches", r.mismatch.empty()}};
+    if (!r.mismatch.empty()) j["reference"]["why_not"] = r.mismatch;
+  } else {
+    j["reference"] = nullptr;
+  }
   j["exposure_ev"] = d.exposure_ev;
   j["transfer"] = d.transfer == Transfer::Gamma2 ? "gamma2" : "srgb";
   j["png"] = fs::path(paths.png).filename().string();

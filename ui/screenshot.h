@@ -5,6 +5,7 @@
 #include "renderer/film/image_io.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/scene/scene.h"
+#include "ui/measure.h"
 
 #include <cstdint>
 #include <ctime>
@@ -29,6 +30,18 @@ struct ScreenshotData {
   std::uint64_t generation = 0;  // not in the sidecar: which render the viewer saved
   Camera camera;                 // as rendered
   bool camera_moved = false;     // moved in the viewer, not the scene file's
+  std::string scene_hash;        // of the view rendered (the camera too when moved): a reference's identity
+  // The figures shown for the image, and what they were measured against.
+  Figures figures;
+  struct ReferenceFacts {
+    bool loaded = false;
+    bool from_cache = false;
+    std::string path, strategy, scene_hash;
+    int width = 0, height = 0, max_depth = 0;
+    std::uint32_t spp = 0;
+    double seconds = 0.0;
+    std::string mismatch;  // why it does not measure the image (empty: it does)
+  } reference;
 };
 
 struct SavedScreenshot {

@@ -94,6 +94,30 @@ const char* preset_label(Preset p) {
   return "?";
 }
 
+SamplingSettings preset_by_key(int key) {
+  if (key == 4) return SamplingSettings::from(Strategy::nee());
+  if (key == 5) return fastest_sampling();
+  return preset_sampling(static_cast<Preset>(std::clamp(key, 1, kPresetCount)));
+}
+
+const char* preset_key_label(int key) {
+  if (key == 4) return "nee-mis";
+  if (key == 5) return "fastest";
+  return preset_label(static_cast<Preset>(std::clamp(key, 1, kPresetCount)));
+}
+
+int preset_key_of(const SamplingSettings& s) {
+  const Strategy strategy = s.strategy();
+  for (int key = kPresetKeyCount; key >= 1; --key)
+    if (preset_by_key(key).strategy() == strategy) return key;
+  return 0;
+}
+
+float panel_width_for(float wish, float scale, float window_width) {
+  const float most = kMaxPanelShare * window_width;
+  return std::max(0.0f, std::min(std::max(wish, kMinPanelWidth) * scale, most));
+}
+
 SamplingSettings preset_sampling(Preset p) {
   switch (p) {
     case Preset::CosineOnly: return SamplingSettings::from(Strategy::single(Technique::Cosine));

@@ -42,6 +42,13 @@ struct SamplingSettings {
 
 enum class Preset { CosineOnly = 1, LightOnly = 2, Book5050 = 3 };
 inline constexpr int kPresetCount = 3;
+// Every preset the panel and the keys 1-5 offer, in their one place: 1-3 the
+// presets above, 4 nee-mis, 5 fastest.
+inline constexpr int kPresetKeyCount = 5;
+SamplingSettings preset_by_key(int key);  // key 1..5
+const char* preset_key_label(int key);   // "cosine only", ..., "nee-mis", "fastest"
+// The key (1..5) whose preset `s` is, or 0.
+int preset_key_of(const SamplingSettings& s);
 // `fastest` (kFastestStrategy), as the panel edits it.
 SamplingSettings fastest_sampling();
 const char* preset_label(Preset p);
@@ -62,6 +69,12 @@ struct SaveMark {
 // those since the save for the saved one.
 double unsaved_seconds(const SaveMark& saved, std::uint64_t generation, double seconds);
 
+inline constexpr float kDefaultPanelWidth = 400.0f, kMinPanelWidth = 240.0f, kMaxPanelShare = 0.45f;
+// The panel's width in the window's units: `wish` (at scale 1) times `scale`,
+// at least kMinPanelWidth * scale and at most kMaxPanelShare of the window
+// (which wins when they disagree).
+float panel_width_for(float wish, float scale, float window_width);
+
 struct ViewerSettings {
   SamplingSettings sampling;
   int max_depth = 50;
@@ -69,12 +82,18 @@ struct ViewerSettings {
   float resolution_scale = 1.0f;
   bool paused = false;
   std::uint32_t stop_spp = 0;  // 0: render until stopped
+  float stop_seconds = 0.0f;   // 0: no time limit; else stop at the first pass after it
   float exposure_ev = 0.0f;
   bool srgb = false;  // false: the book's gamma 2
   std::string screenshot_dir = "screenshots";
   MeasureSettings measure;
   // Presentation: full screen, no side panel, no badges or inspector over the image.
   bool presentation = false;
+  bool caption = false;  // in presentation mode, a caption: strategy, spp, time
+  // The side panel: its width at UI scale 1 (the window's scale multiplies
+  // it; it never takes more than kMaxPanelShare of the window), and hidden (Tab).
+  float panel_width = kDefaultPanelWidth;
+  bool panel_hidden = false;
   float ui_scale = 1.0f;  // panels and text, times the screen's content scale
   // Non-zero: render at exactly this size instead of the scene's times
   // resolution_scale (set to match a reference image).
@@ -91,13 +110,18 @@ inline constexpr float kMinUiScale = 0.5f, kMaxUiScale = 4.0f;
 // What the panels ask for this frame, beyond edits to ViewerSettings.
 struct UiRequests {
   bool restart_render = false;  // sampling, depth, seed or resolution changed, or "Restart"
-  bool stop_changed = false;
+  bool stop_changed = false;    // stop_spp or stop_seconds
   bool pause_changed = false;
   bool screenshot = false;
   bool retry_screenshot = false;
   bool toggle_presentation = false;
   bool toggle_camera_mode = false;
   bool reset_camera = false;
+  bool save_film = false;
+  bool export_view = false;         // the false-colour view as a PNG figure
+  bool export_curve = false;        // the predicted curve as SVG and CSV
+  bool export_convergence = false;  // the convergence plot as SVG and CSV
+  bool toggle_panel = false;
   std::string load_scene;  // non-empty: try this file
   MeasureRequests measure;
 };
@@ -123,6 +147,12 @@ struct WeightCurveStatus {
   std::vector<float> history;  // auto weight: each pass's weight, oldest first
 };
 
+// A line for the panel's message line: an error, a warning or a note.
+struct PanelMessage {
+  enum Kind { Note, Warning, Error } kind = Note;
+  std::string text;
+};
+
 // Read-only facts the panels show.
 struct UiStatus {
   SessionStats stats;
@@ -146,7 +176,21 @@ struct UiStatus {
   const MeasureState* measure = nullptr;  // the viewer's; null in tests without one
   const SplitState* split = nullptr;      // while the split screen is on: its two sides
   WeightCurveStatus weights;
+  float scale = 1.0f;           // the screen's content scale times the UI scale
+  int max_depth = 0;            // of the render
+  // The messages of the moment, most pressing first: the panel's message line
+  // shows the first, its tooltip all of them.
+  std::vector<PanelMessage> messages;
+  bool can_export_view = false;         // a false-colour view is shown
+  bool can_export_curve = false;        // a predicted curve is shown
+  bool can_export_convergence = false;  // the convergence plot has points
 };
+
+// The side panel's sections, in order; the open ones are remembered between runs.
+inline constexpr int kPanelSectionCount = 6;
+inline constexpr std::array<const char*, kPanelSectionCount> kPanelSections = {
+    "Sampling", "Scene and render", "Statistics", "Measure", "Display", "Screenshots and figures"};
+inline constexpr std::array<bool, kPanelSectionCount> kPanelSectionsOpen = {true, true, false, true, false, false};
 
 // Text-field buffers and other panel-local state that is not a setting.
 struct PanelState {
@@ -155,6 +199,11 @@ struct PanelState {
   bool scene_field_initialised = false;
   // The two techniques of the "w" slider, kept while it is dragged to 0 or 1.
   std::array<int, 2> w_pair{-1, -1};
+  std::array<bool, kPanelSectionCount> open = kPanelSectionsOpen;
+  // The last predicted curve shown, and its pair: drawn greyed while the next
+  // one is computed, so the box never empties.
+  WeightCurveStatus last_curve;
+  std::array<int, 2> last_curve_pair{-1, -1};
 };
 
 }  // namespace pdflab::ui

@@ -67,10 +67,11 @@ struct SplitRequests {
   bool load_reference = false;  // reference_path to be (re)loaded; empty clears
 };
 
-// The divider line and the two sides' figures over the image rectangle
-// (ImGui coordinates), then the small controls window below its top edge.
+// The divider line over the image rectangle (ImGui coordinates) and the two
+// sides' figures in the area's top corners; then the small controls window at
+// its bottom left (both placed by ui/layout_report).
 void draw_split_overlay(const SplitState& state, float left, float top, float width, float height);
-void draw_split_controls(SplitState& state, SplitRequests& requests, float area_width, float area_height);
+void draw_split_controls(SplitState& state, SplitRequests& requests);
 
 // "12.3%", "3.2e-04": compact figures for the side boxes.
 std::string format_figure(double value, bool percent = false);

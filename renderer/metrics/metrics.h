@@ -55,12 +55,15 @@ double efficiency(double relmse_value, double seconds);
 // flat; when that product grows by more than 2x over a doubling of the samples
 // (the estimate did not fall at all), rare bright paths are still being found
 // and the estimate says little: unreliable() stays true for the render.
+// unreliable_now() judges the latest doubling alone: it clears again once the
+// product holds still, as a viewer showing the render as it goes needs.
 class EstimateHistory {
  public:
   static constexpr double kGrowthLimit = 2.0;
   void clear() { *this = EstimateHistory(); }
   void add(std::uint32_t spp, double estimated_relmse);
   bool unreliable() const { return unreliable_; }
+  bool unreliable_now() const { return growth_ > kGrowthLimit; }
   // estimate * spp now over the same at half the samples or fewer (0 before then).
   double growth() const { return growth_; }
   // The points kept: (spp, estimate * spp), at least 2% apart in spp.

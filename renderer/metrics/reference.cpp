@@ -379,6 +379,15 @@ ReferenceProgress reference_progress(const ReferenceGoal& goal, std::uint32_t sp
   p.fraction = std::clamp(p.fraction, 0.0, 1.0);
   if (p.reached) p.fraction = 1.0;
   if (!p.reached && p.fraction > 0.0 && seconds > 0.0) p.seconds_left = seconds * (1.0 - p.fraction) / p.fraction;
+  if (!p.reached && goal.max_seconds > 0.0) {
+    if (seconds >= goal.max_seconds) {
+      p.reached = p.capped = true;
+      p.seconds_left = 0.0;
+    } else {
+      const double limit_left = goal.max_seconds - seconds;
+      p.seconds_left = p.seconds_left > 0.0 ? std::min(p.seconds_left, limit_left) : limit_left;
+    }
+  }
   return p;
 }
 

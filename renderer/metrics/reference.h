@@ -140,11 +140,15 @@ struct ReferenceGoal {
   std::uint32_t spp = 0;  // stop at this many samples per pixel, or
   double seconds = 0.0;   // after this much rendering time, or
   double relmse = 0.0;    // when the film's own relMSE estimate is at most this
+  // Beside the goal: stop after this much time at the latest, goal reached or
+  // not (0: no limit). A reference stopped by it is short of its goal.
+  double max_seconds = 0.0;
 };
 struct ReferenceProgress {
   double fraction = 0.0;      // 0..1
   double seconds_left = 0.0;  // estimated; 0 when unknown
-  bool reached = false;
+  bool reached = false;       // the goal, or the time limit (then `capped`)
+  bool capped = false;        // stopped by max_seconds short of the goal
 };
 // Where a render of `spp` samples after `seconds` stands. An unbiased
 // estimate's relMSE falls as 1/time, which predicts the time to a relMSE target.

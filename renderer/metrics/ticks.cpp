@@ -43,7 +43,8 @@ std::string tick_label(double v) {
   if (v == 0.0) return "0";
   char buf[32];
   const double a = std::abs(v);
-  std::snprintf(buf, sizeof buf, a >= 1e-3 && a < 1e4 ? "%.3g" : "%.0e", v);
+  // %.3g writes 1000 as 1e+03: four digits from 100 on, so the ticks read 100, 1000.
+  std::snprintf(buf, sizeof buf, a >= 1e-3 && a < 1e4 ? (a >= 100.0 ? "%.4g" : "%.3g") : "%.0e", v);
   return buf;
 }
 

@@ -20,8 +20,9 @@ std::vector<double> nice_ticks(double lo, double hi, int max_ticks = 6);
 // Powers of ten inside [lo, hi] (lo > 0), each one exact within 1e-9 of a decade.
 std::vector<double> decade_ticks(double lo, double hi);
 
-// Short tick label: 0, 0.5, 2, 0.001, 1e-04, 1e+04 (three significant digits
-// between 1e-3 and 1e4, one digit and an exponent outside).
+// Short tick label: 0, 0.5, 2, 0.001, 100, 1000, 1e-04, 1e+04 (three
+// significant digits between 1e-3 and 100, four up to 1e4, one digit and an
+// exponent outside).
 std::string tick_label(double v);
 
 }  // namespace pdflab

@@ -43,9 +43,10 @@ ReferenceProgress ReferenceBuild::poll() {
   // The relMSE goal is judged on the last published pass, with that pass's time.
   ReferenceProgress p = reference_progress(job_.goal, job_.goal.relmse > 0.0 ? estimate_spp_ : st.spp,
                                            st.seconds, estimated_relmse_);
-  if (job_.goal.spp > 0) p.reached = st.done;
+  if (job_.goal.spp > 0 && !p.capped) p.reached = st.done;
   if (p.reached && !reached_) {
     reached_ = true;
+    capped_ = p.capped;
     if (!st.done) session_.set_paused(true);
   }
   if (reached_) {

@@ -34,6 +34,8 @@ class ReferenceBuild {
   // Where it stands; pauses the render once the goal is reached. Cheap.
   ReferenceProgress poll();
   bool done() const { return reached_; }
+  // Stopped by the goal's max_seconds short of the goal itself.
+  bool capped() const { return capped_; }
   SessionStats stats() const { return session_.stats(); }
   const ReferenceJob& job() const { return job_; }
   // After done(): the reference with its sidecar filled (waits for the pass in flight).
@@ -43,6 +45,7 @@ class ReferenceBuild {
   ReferenceJob job_;
   RenderSession session_;
   bool reached_ = false;
+  bool capped_ = false;
   double estimated_relmse_ = 0.0;
   std::uint32_t estimate_spp_ = 0;
   std::vector<float> scratch_;

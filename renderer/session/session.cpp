@@ -88,19 +88,23 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   const Camera& cam = settings_.scene->camera;
   spp_done_ = 0;
   drops_ = DropCounts{};
+  samples_done_ = 0;
+  seconds_before_ = 0.0;
   if (start) {
     film_ = std::move(start->film);
     spp_done_ = start->spp;
     drops_ = start->dropped;
+    if (start->seconds > 0.0) {
+      samples_done_ = static_cast<std::uint64_t>(start->spp) * film_.pixel_count();
+      seconds_before_ = start->seconds;
+    }
   } else if (film_.width() != cam.width || film_.height() != cam.height) {
     film_.reset(cam.width, cam.height);
   } else {
     film_.clear();
   }
-  samples_done_ = 0;
   noise_ = NoiseSummary{};
   next_sweep_spp_ = 0;
-  seconds_before_ = 0.0;
   running_clock_ = false;
   next_pass_spp_ = 1;
   preview_due_ = options_.preview;
@@ -121,7 +125,7 @@ int RenderSession::preview_scale_locked() const {
 void RenderSession::start_pass_locked() {
   if (!settings_.scene) return;
   const std::uint32_t target = settings_.target_spp;
-  if (target != 0 && spp_done_ >= target) return;
+  if (target_reached_locked(elapsed_locked())) return;
   std::uint32_t spp = next_pass_spp_;
   if (target != 0) spp = std::min(spp, target - spp_done_);
   const Camera& cam = settings_.scene->camera;
@@ -212,7 +216,7 @@ void RenderSession::finish_pass_locked() {
   if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;
   if (pass_ms > 120.0 && next_pass_spp_ > 1) next_pass_spp_ /= 2;
 
-  const bool done = settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
+  const bool done = target_reached_locked(seconds_before_ + std::chrono::duration<double>(now - resumed_at_).count());
   if (done || paused_) {
     seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
     running_clock_ = false;
@@ -387,6 +391,17 @@ void RenderSession::set_target_spp(std::uint32_t target_spp) {
   done_cv_.notify_all();
 }
 
+void RenderSession::set_target_seconds(double target_seconds) {
+  {
+    std::lock_guard lk(mutex_);
+    const double t = std::isfinite(target_seconds) ? std::max(0.0, target_seconds) : 0.0;
+    if (pending_) pending_settings_.target_seconds = t;
+    settings_.target_seconds = t;
+    if (!paused_ && !pass_open_ && !pending_) start_pass_locked();
+  }
+  done_cv_.notify_all();
+}
+
 void RenderSession::set_paused(bool paused) {
   {
     std::lock_guard lk(mutex_);
@@ -395,6 +410,12 @@ void RenderSession::set_paused(bool paused) {
     if (!paused_ && !pass_open_) start_pass_locked();
   }
   done_cv_.notify_all();
+}
+
+bool RenderSession::target_reached_locked(double elapsed) const {
+  const std::uint32_t spp = settings_.target_spp;
+  const double seconds = settings_.target_seconds;
+  return (spp != 0 && spp_done_ >= spp) || (seconds > 0.0 && spp_done_ > 0 && elapsed >= seconds);
 }
 
 double RenderSession::elapsed_locked() const {
@@ -422,8 +443,10 @@ SessionStats RenderSession::stats() const {
   st.samples = samples_done_ + partial;
   st.samples_per_second = st.seconds > 0.0 ? static_cast<double>(st.samples) / st.seconds : 0.0;
   const std::uint32_t target = settings_.target_spp;
-  st.done = target != 0 && spp_done_ >= target && !pending_;
+  // A lowered spp target counts at once (the pass in flight still ends); the time limit once the pass has.
+  st.done = (target != 0 && spp_done_ >= target) || (!pass_open_ && target_reached_locked(st.seconds));
   if (target != 0) st.progress = std::min(1.0, (spp_done_ + pass_fraction * pass_.spp) / target);
+  if (settings_.target_seconds > 0.0) st.progress = std::max(st.progress, std::min(1.0, st.seconds / settings_.target_seconds));
   st.dropped = drops_;
   st.estimated_relmse = noise_.estimated_relmse;
   return st;
@@ -432,7 +455,7 @@ SessionStats RenderSession::stats() const {
 bool RenderSession::wait_until_done(std::chrono::milliseconds timeout) {
   std::unique_lock lk(mutex_);
   auto done = [&] {
-    return !pending_ && !pass_open_ && settings_.target_spp != 0 && spp_done_ >= settings_.target_spp;
+    return !pending_ && !pass_open_ && target_reached_locked(elapsed_locked());
   };
   if (timeout == std::chrono::milliseconds::max()) {
     done_cv_.wait(lk, done);

@@ -28,17 +28,24 @@ struct RenderSettings {
   Strategy strategy = Strategy::single(Technique::Cosine);
   std::uint64_t seed = 1;
   std::uint32_t target_spp = 0;  // 0: render until stopped
+  // Also stop at the first pass boundary after this much rendering time (0: no
+  // time limit); whichever of the two comes first ends the render.
+  double target_seconds = 0.0;
   // Sample index of the film's first sample: renders of disjoint index ranges
   // of one seed (on several machines) merge into one render of their union.
   std::uint32_t first_sample = 0;
 };
 
 // An accumulation to continue (a saved film): `spp` samples per pixel, indices
-// first_sample .. first_sample + spp - 1, with its drop counts.
+// first_sample .. first_sample + spp - 1, with its drop counts and the
+// rendering time it took. With that time the session's clock and sample count
+// go on from the film's, so time, samples per second and efficiency describe
+// the whole film; without it (0) they start at 0 and describe this run alone.
 struct FilmStart {
   Film film;
   std::uint32_t spp = 0;
   DropCounts dropped;
+  double seconds = 0.0;
 };
 
 struct SessionStats {
@@ -47,11 +54,11 @@ struct SessionStats {
   std::uint64_t samples = 0;       // pixel samples traced in this generation
   double seconds = 0.0;            // rendering time of this generation (pauses excluded)
   double samples_per_second = 0.0;
-  double progress = 0.0;           // 0..1 of target_spp (0 when unlimited)
+  double progress = 0.0;           // 0..1 of target_spp or target_seconds, the nearer (0 when unlimited)
   DropCounts dropped;
   // The film's own relMSE estimate (metrics.h) after the last full pass; 0 before one.
   double estimated_relmse = 0.0;
-  bool done = false;               // target_spp reached
+  bool done = false;               // target_spp or target_seconds reached
   bool paused = false;
 };
 
@@ -125,13 +132,15 @@ class RenderSession {
   // Changes when rendering stops (0: never) without restarting the accumulation;
   // a target below the current spp stops after the pass in flight.
   void set_target_spp(std::uint32_t target_spp);
+  // The same for the time limit (0: none).
+  void set_target_seconds(double target_seconds);
   // Bumped by every set_settings; compare with ImageInfo::generation.
   std::uint64_t generation() const { return generation_.load(); }
 
   SessionStats stats() const;
   int thread_count() const { return static_cast<int>(workers_.size()); }
 
-  // Blocks until target_spp is reached (true) or the timeout passes (false).
+  // Blocks until target_spp or target_seconds is reached (true) or the timeout passes (false).
   bool wait_until_done(std::chrono::milliseconds timeout = std::chrono::milliseconds::max());
 
   // The latest completed pass as mean float RGB. Returns false (and leaves `out`
@@ -187,6 +196,8 @@ class RenderSession {
   void wait_idle_locked(std::unique_lock<std::mutex>& lk, const char* caller) const;
   void start_pass_locked();
   double elapsed_locked() const;
+  // The spp or the time limit reached, the time as of `elapsed` seconds.
+  bool target_reached_locked(double elapsed) const;
 
   // Tiles are the unit of scheduling and of the noise sweep; runs of them the
   // unit of tracing. The packet tracer's lanes drain at the end of each block it

@@ -8,14 +8,14 @@ source "$(dirname "$0")/lib.sh"
 inside_xvfb "1400x900x24" "xdotool import" "$0" "$@"
 shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
+# From the repository's root, so the panel's path field shows a path within it.
+cd "$root"
 pdflab=${1:-$root/build/release/app/pdflab}
 seconds=${2:-20}
-scene=$root/assets/scenes/cornell_book.json
+scene=assets/scenes/cornell_book.json
 
 start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
-area=$((WIDTH - 400))
-size=$((area < HEIGHT ? area : HEIGHT))
-left=$(((area - size) / 2)) top=$(((HEIGHT - size) / 2))
+read -r left top size <<<"$(layout_py "'%d %d %d' % (d['image']['x'], d['image']['y'], d['image']['w'])")"
 sleep "$seconds"
 # The glass sphere: zoom in about it, the inspector reads the pixel under the cursor.
 mx=$((left + size * 58 / 100)) my=$((top + size * 77 / 100))

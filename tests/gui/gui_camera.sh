@@ -24,7 +24,7 @@ save() {
 
 # 16 spp and stop: every image below is complete and comparable.
 PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine --spp 16
-cx=$(((WIDTH - 400) / 2)) cy=$((HEIGHT / 2))
+read -r cx cy <<<"$(layout_py "'%d %d' % (d['image']['x'] + d['image']['w'] / 2, d['image']['y'] + d['image']['h'] / 2)")"
 sleep 2
 first=$(save 1)
 echo "scene's camera: $(json_field "$first.json" camera)"

@@ -18,9 +18,8 @@ colours() { identify -format "%k" "$1"; }
 PDFLAB_SCREENSHOT_DIR="$art/shots" start_viewer "$pdflab" --scene "$scene" --strategy cosine
 "$pdflab" render --scene "$scene" --strategy cosine --spp 1 --out "$art/size.png" --quiet >/dev/null
 read -r iw ih <<<"$(identify -format '%w %h' "$art/size.png")"
-area=$((WIDTH - 400))
-size=$((area < HEIGHT ? area : HEIGHT))
-left=$(((area - size) / 2)) top=$(((HEIGHT - size) / 2))
+read -r area left top size <<<"$(layout_py "'%d %d %d %d' % (d['image_area']['w'], d['image']['x'], d['image']['y'], d['image']['w'])")"
+windowed_width=$WIDTH
 echo "window ${WIDTH}x${HEIGHT}, image ${iw}x${ih} fitted at $left,$top size $size"
 sleep 1
 send_key space   # pause: the image on screen stays what F12 saves
@@ -108,6 +107,6 @@ send_key Escape
 sleep 1.5
 alive "$viewer" "Esc in presentation mode"
 eval "$(xdotool getwindowgeometry --shell "$wid")"
-[ "$WIDTH" = 720 ] || fail "Esc did not leave presentation mode (${WIDTH}x${HEIGHT})"
+[ "$WIDTH" = "$windowed_width" ] || fail "Esc did not leave presentation mode (${WIDTH}x${HEIGHT})"
 quit_viewer
 echo "PASS"

@@ -30,12 +30,9 @@ sleep 2
 shot base
 not_blank "$art/base.png"
 
-# The image area is left of the 400-pixel side panel; the (square) image is
-# centred in it.
-area_w=$((WIDTH - 400))
-cx=$((area_w / 2)) cy=$((HEIGHT / 2))
-size=$((area_w < HEIGHT ? area_w : HEIGHT))
-left=$(((area_w - size) / 2)) top=$(((HEIGHT - size) / 2))
+# Where the (square) image is, from the viewer's layout report.
+read -r left top size <<<"$(layout_py "'%d %d %d' % (d['image']['x'], d['image']['y'], d['image']['w'])")"
+cx=$((left + size / 2)) cy=$((top + size / 2))
 
 echo "== split screen"
 send_key s

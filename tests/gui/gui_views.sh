@@ -27,10 +27,8 @@ cat "$art/bad_reference.txt"
 # The strategy drops samples on this scene (its pdf overflows for the tiny target).
 start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5" --reference "$art/reference.pfm"
 sleep 3
-# The image sits centred in the area left of the 400-pixel panel.
-area=$((WIDTH - 400))
-side=$(( area < HEIGHT ? area : HEIGHT ))
-crop="$((side - 40))x$((side - 40))+$((20 + (area - side) / 2))+$((20 + (HEIGHT - side) / 2))"
+# The image as the viewer's layout report places it, less a margin.
+crop=$(layout_py "'%dx%d+%d+%d' % (d['image']['w'] - 40, d['image']['h'] - 40, d['image']['x'] + 20, d['image']['y'] + 20)")
 echo "window ${WIDTH}x${HEIGHT}, image crop $crop"
 
 modes=(image heatmap difference drops)
@@ -46,12 +44,12 @@ for _ in 1 2 3; do send_key v; sleep 0.2; done
 echo "== the heat map's error metric (E) and its range (the panel)"
 send_key space   # paused: every change below is the control's doing
 sleep 1
-legend="300x150+$((area - 310))+0"
 # look NAME: the image area and the colour bar's window.
 look() {
   sleep 1.5
   shot "window_$1"
   convert "$art/window_$1.png" -crop "$crop" +repage "$art/$1.png"
+  legend=$(layout_py "[ '%dx%d+%d+%d' % (w['w'], w['h'], w['x'], w['y']) for w in d['windows'] if w['name'] == '##view legend'][0]")
   convert "$art/window_$1.png" -crop "$legend" +repage "$art/$1_legend.png"
 }
 send_key v
@@ -64,17 +62,18 @@ send_key shift+e
 look heat_auto     # the relative standard error again, on an automatic range
 changed "$art/heat_fixed.png" "$art/heat_auto.png" 0.02
 changed "$art/heat_fixed_legend.png" "$art/heat_auto_legend.png" 0.01
-# The panel scrolled to its end: the range controls sit at fixed places above its bottom.
-xdotool mousemove "$((area + 200))" "$((HEIGHT / 2))"
-for _ in $(seq 25); do xdotool click 5; sleep 0.03; done
-sleep 0.5
-shot panel_end "400x${HEIGHT}+${area}+0"
-xdotool mousemove "$((area + 39))" "$((HEIGHT - 198))" click 1   # auto range: off
-xdotool mousemove 2 2
+# The Display section opened, and scrolled to its range controls.
+reveal section.4
+click section.4
+reveal display.auto_range
+shot panel_end
+click display.auto_range   # auto range: off
 look heat_set      # set by hand where the automatic range was: nothing jumps
 same "$art/heat_auto.png" "$art/heat_set.png" 0.01
 changed "$art/heat_auto_legend.png" "$art/heat_set_legend.png" 0.002  # "range: as set in the panel"
-xdotool mousemove "$((area + 215))" "$((HEIGHT - 173))" click 1   # the max slider, near its low end
+reveal display.range_max
+read -r mx my mw mh <<<"$(item display.range_max)"
+xdotool mousemove "$((mx + mw / 12))" "$((my + mh / 2))" click 1   # the max slider, near its low end
 xdotool mousemove 2 2
 look heat_low_max  # a lower top: more pixels at the bright end
 changed "$art/heat_set.png" "$art/heat_low_max.png" 0.02

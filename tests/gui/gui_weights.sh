@@ -43,11 +43,9 @@ start_viewer "$pdflab" --scene "$scene" --strategy "mix:cosine=0.5,light=0.5"
 # with the first pass, so a later first look may already show a settled curve.
 import -window "$wid" "$art/panel_early.png"
 sleep 7
-area=$((WIDTH - 400))
-side=$(( area < HEIGHT ? area : HEIGHT ))
-crop="$((side - 40))x$((side - 40))+$((20 + (area - side) / 2))+$((20 + (HEIGHT - side) / 2))"
-# The prediction's lines sit right under the w slider, near the panel's top.
-panel="380x170+$((WIDTH - 390))+90"
+crop=$(layout_py "'%dx%d+%d+%d' % (d['image']['w'] - 40, d['image']['h'] - 40, d['image']['x'] + 20, d['image']['y'] + 20)")
+# The prediction's box under the w slider (the viewer's layout report says where).
+panel=$(crop_of sampling.curve)
 import -window "$wid" "$art/panel.png"
 convert "$art/panel_early.png" -crop "$panel" +repage "$art/curve_early.png"
 convert "$art/panel.png" -crop "$panel" +repage "$art/curve.png"

@@ -18,7 +18,12 @@ inside_xvfb() {
   exec xvfb-run -a -s "-screen 0 $screen" bash "$script" --inside "$@"
 }
 
-fail() { echo "FAIL: $*"; exit 1; }
+# fail WHY: ends the test, also from inside $(...) (a subshell would only end itself).
+fail() {
+  echo "FAIL: $*" >&2
+  [ "$BASHPID" = "$$" ] || kill -TERM $$
+  exit 1
+}
 
 # The viewer loads the cached reference of its scene by itself: the tests never
 # see the user's cache (a test that wants one sets its own folder).
@@ -42,19 +47,31 @@ focus_window() {
 
 # start_viewer PDFLAB ARG...: the viewer in the background ($viewer, killed if
 # the script ends before quit_viewer), its window focused (wid, WIDTH, HEIGHT)
-# and the pointer parked in the corner, away from the panel's tooltips.
-# Environment assignments before it reach the viewer.
+# and the pointer parked in the corner, away from the panel's tooltips. It
+# writes its layout to $layout (--layout-json) and keeps its remembered
+# settings in $viewer_config (a fresh folder per start unless the test sets
+# one). Environment assignments before it reach the viewer.
+viewer_config=
+layout=
+gui_tmp=      # the reports and settings folders of this script's viewers, removed at exit
+viewer_starts=0
 start_viewer() {
   # The last viewer's window must be gone, or the search could find it.
   for _ in $(seq 50); do xdotool search --name '^pdflab' >/dev/null 2>&1 || break; sleep 0.1; done
-  "$@" &
+  [ -n "$gui_tmp" ] || gui_tmp=$(mktemp -d -t pdflab-gui-XXXXXX)
+  viewer_starts=$((viewer_starts + 1))
+  layout=$gui_tmp/layout-$viewer_starts.json
+  local config=${viewer_config:-$gui_tmp/config-$viewer_starts}
+  mkdir -p "$config"
+  PDFLAB_CONFIG_DIR="$config" "$@" --layout-json "$layout" &
   viewer=$!
   focus_window
   xdotool mousemove 2 2
+  await_layout 'True'
 }
 viewer=
 at_exit=  # more to do when the script ends (e.g. remove a temporary folder)
-trap '[ -z "$viewer" ] || kill "$viewer" 2>/dev/null || true; eval "$at_exit"' EXIT
+trap '[ -z "$viewer" ] || kill "$viewer" 2>/dev/null || true; eval "$at_exit"; [ -z "$gui_tmp" ] || rm -rf "$gui_tmp"' EXIT
 
 # quit_viewer: Ctrl+Q, and Ctrl+Q again ("quit anyway") when it asks first (a
 # render of more than a few seconds, unsaved); waits for the exit status,
@@ -120,4 +137,88 @@ json_field() {
 d = json.load(open(sys.argv[1]))
 for k in sys.argv[2:]: d = d[k]
 print(d)' "$@"
+}
+
+# The viewer's own layout report ($layout, from --layout-json): rectangles of
+# the panel, the image, the overlays and named controls, in window coordinates.
+# layout_py EXPRESSION: evaluates EXPRESSION with d = the report (Python); prints it.
+layout_py() {
+  /usr/bin/python3 - "$layout" "$1" <<'PY'
+import json, sys
+try:
+    d = json.load(open(sys.argv[1]))
+except (OSError, ValueError):
+    sys.exit(3)
+print(eval(sys.argv[2], {"d": d}))
+PY
+}
+# await_layout CONDITION: waits (up to 20 s) until the Python CONDITION on d holds.
+await_layout() {
+  local end=$((SECONDS + 20))
+  while :; do
+    [ "$(layout_py "bool($1)" 2>/dev/null)" = True ] && return 0
+    [ "$SECONDS" -lt "$end" ] || fail "the layout never showed: $1"
+    sleep 0.2
+  done
+}
+# item NAME: "x y w h" of a named control (integers), once the report has it.
+item() {
+  await_layout "'$1' in d['items']"
+  layout_py "' '.join(str(int(round(d['items']['$1'][k]))) for k in ('x', 'y', 'w', 'h'))"
+}
+# centre NAME: "x y" of a named control's centre.
+centre() {
+  local x y w h
+  read -r x y w h <<<"$(item "$1")"
+  echo "$((x + w / 2)) $((y + h / 2))"
+}
+# click NAME: a mouse click on a named control (the pointer then parked in the corner).
+click() {
+  local x y
+  read -r x y <<<"$(centre "$1")"
+  xdotool mousemove "$x" "$y"
+  sleep 0.15
+  xdotool click 1
+  sleep 0.15
+  xdotool mousemove 2 2
+}
+# crop_of NAME: an ImageMagick geometry for a named control's rectangle.
+crop_of() {
+  local x y w h
+  read -r x y w h <<<"$(item "$1")"
+  echo "${w}x${h}+${x}+${y}"
+}
+# reveal NAME: scrolls the side panel until the control lies inside its
+# visible part (the sections scroll under the panel's head).
+reveal() {
+  local i x y w h top bottom
+  for i in $(seq 40); do
+    read -r x y w h <<<"$(item "$1")"
+    read -r top bottom <<<"$(layout_py "'%d %d' % (d['items']['panel.sections']['y'], d['items']['panel.sections']['y'] + d['items']['panel.sections']['h'])")"
+    if [ "$y" -ge "$top" ] && [ $((y + h)) -le "$bottom" ]; then return 0; fi
+    read -r px _ <<<"$(centre panel)"
+    xdotool mousemove "$px" "$(((top + bottom) / 2))"
+    if [ "$y" -lt "$top" ]; then xdotool click 4; else xdotool click 5; fi
+    sleep 0.25
+  done
+  fail "could not scroll $1 into view"
+}
+# no_overlaps: the report's overlays overlap neither each other nor the image's middle (keep_out).
+no_overlaps() {
+  /usr/bin/python3 - "$layout" <<'PY' || fail "overlays overlap (see above)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+def box(r): return (r["x"], r["y"], r["x"] + r["w"], r["y"] + r["h"])
+def meet(a, b): return a[0] < b[2] - 0.5 and b[0] < a[2] - 0.5 and a[1] < b[3] - 0.5 and b[1] < a[3] - 0.5
+over = [w for w in d["windows"] if w["role"] == "overlay"]
+keep = box(d["keep_out"])
+bad = False
+for i, a in enumerate(over):
+    if meet(box(a), keep): print("over the image's middle:", a["name"], box(a), keep); bad = True
+    for b in over[i + 1:]:
+        if meet(box(a), box(b)): print("overlap:", a["name"], box(a), b["name"], box(b)); bad = True
+print("overlays:", ", ".join("%s %dx%d+%d+%d" % (w["name"], w["w"], w["h"], w["x"], w["y"]) for w in over),
+      "| keep-out %dx%d+%d+%d" % (d["keep_out"]["w"], d["keep_out"]["h"], d["keep_out"]["x"], d["keep_out"]["y"]))
+sys.exit(1 if bad else 0)
+PY
 }

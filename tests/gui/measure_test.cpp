@@ -597,3 +597,127 @@ TEST(WeightViews, BestWeightLegendRunsFromZeroToOneAndGreyMeansNone) {
 }
 
 }  // namespace
+
+TEST(ReferenceIdentity, ACameraSceneDepthOrSizeChangeTurnsTheFiguresToEstimatesAndSaysWhy) {
+  MeasureState m;
+  ImageIdentity render{"aaaa", "aaaa", 4, 2, 8, false};
+  m.set_render_identity(render);
+  ReferenceImage ref = flat_reference(4, 2, 0.5f);
+  ref.info.has_sidecar = true;
+  ref.info.scene_hash = "aaaa";
+  ref.info.max_depth = 8;
+  m.published = flat_image(4, 2, 0.55f);
+  m.set_reference(ref);
+  m.on_image(0, "cosine");
+  EXPECT_TRUE(m.figures.against_reference);
+  EXPECT_TRUE(m.reference_mismatch().empty());
+  EXPECT_NE(m.matching_reference(), nullptr);
+
+  // The camera orbits: the view's hash is another, the scene's the same.
+  render.view_hash = "bbbb";
+  m.set_render_identity(render);
+  m.on_image(0, "cosine");
+  EXPECT_FALSE(m.figures.against_reference);
+  EXPECT_NE(m.figures.estimate_why.find("camera moved"), std::string::npos) << m.figures.estimate_why;
+  EXPECT_EQ(m.matching_reference(), nullptr);
+  EXPECT_FALSE(m.refresh_layer(ViewMode::Difference));
+  EXPECT_NE(m.layer_why.find("camera moved"), std::string::npos) << m.layer_why;
+
+  // Another scene; another depth; another size.
+  render = {"cccc", "cccc", 4, 2, 8, false};
+  m.set_render_identity(render);
+  EXPECT_NE(m.reference_mismatch().find("another scene"), std::string::npos) << m.reference_mismatch();
+  render = {"aaaa", "aaaa", 4, 2, 3, false};
+  m.set_render_identity(render);
+  EXPECT_NE(m.reference_mismatch().find("max depth 8, the render 3"), std::string::npos) << m.reference_mismatch();
+  render = {"aaaa", "aaaa", 4, 2, 8, false};
+  m.set_render_identity(render);
+  m.published = flat_image(8, 8, 0.55f);
+  EXPECT_NE(m.reference_mismatch().find("4x2, the render 8x8"), std::string::npos) << m.reference_mismatch();
+  // Back where it was: measured again.
+  m.published = flat_image(4, 2, 0.55f);
+  m.on_image(0, "cosine");
+  EXPECT_TRUE(m.figures.against_reference);
+}
+
+TEST(ReferenceIdentity, ABarePfmIsTakenAsTheRenderItWasLoadedFor) {
+  MeasureState m;
+  m.set_render_identity({"aaaa", "aaaa", 4, 2, 8, false});
+  m.published = flat_image(4, 2, 0.55f);
+  m.set_reference(flat_reference(4, 2, 0.5f));  // no sidecar
+  EXPECT_TRUE(m.reference_identity.assumed);
+  EXPECT_EQ(m.reference_identity.view_hash, "aaaa");
+  EXPECT_TRUE(m.reference_mismatch().empty());
+  m.set_render_identity({"bbbb", "aaaa", 4, 2, 8, false});
+  EXPECT_FALSE(m.reference_mismatch().empty());
+  // Loaded before the render's identity is known (--reference at start-up): the first one it sees.
+  MeasureState early;
+  early.set_reference(flat_reference(4, 2, 0.5f));
+  early.set_render_identity({"dddd", "dddd", 4, 2, 5, false});
+  EXPECT_EQ(early.reference_identity.view_hash, "dddd");
+  EXPECT_EQ(early.reference_identity.max_depth, 5);
+}
+
+TEST(Reference, AReferenceWhoseNoiseIsAboveAQuarterIsRough) {
+  ReferenceImage ref = flat_reference(4, 2, 0.5f);
+  const PublishedImage img = flat_image(4, 2, 0.6f);  // raw relMSE 0.01 / 0.26
+  ref.variance.assign(24, 0.002f);                    // 20% of it: measured
+  EXPECT_FALSE(compute_figures(img.info, img.rgb, &ref).rough_reference);
+  ref.variance.assign(24, 0.004f);  // 40%: rough
+  const Figures f = compute_figures(img.info, img.rgb, &ref);
+  EXPECT_TRUE(f.against_reference);
+  EXPECT_TRUE(f.rough_reference);
+  EXPECT_NEAR(f.reference_share, 0.4, 1e-5);
+  ref.variance.clear();  // unknown noise: not called rough (it cannot be told)
+  EXPECT_FALSE(compute_figures(img.info, img.rgb, &ref).rough_reference);
+}
+
+TEST(MakeReference, AimsAtAShareOfTheFiguresOrAStatedSppWithinItsTimeLimit) {
+  MeasureSettings s;
+  s.make_seconds = 40.0f;
+  Figures now;
+  std::string note;
+  // No figures yet: the stated spp.
+  ReferenceGoal g = reference_goal(s, now, note);
+  EXPECT_EQ(g.spp, s.make_spp);
+  EXPECT_EQ(g.relmse, 0.0);
+  EXPECT_DOUBLE_EQ(g.max_seconds, 40.0);
+  EXPECT_NE(note.find("no figures yet"), std::string::npos) << note;
+  now.valid = true;
+  now.spp = 64;
+  now.estimated_relmse = 0.019;
+  g = reference_goal(s, now, note);
+  EXPECT_EQ(g.spp, 0u);
+  // Its noise 5% of the raw error: relMSE 0.05 / 0.95 of the render's.
+  EXPECT_NEAR(g.relmse, 0.001, 1e-12);
+  EXPECT_NEAR(g.relmse / (g.relmse + now.estimated_relmse), kTargetShare, 1e-12);
+  s.make_target = ReferenceTarget::Spp;
+  s.make_spp = 512;
+  g = reference_goal(s, now, note);
+  EXPECT_EQ(g.spp, 512u);
+  EXPECT_EQ(note, "target: 512 spp");
+  // Stopped by the time limit short of the goal: reached, and capped.
+  ReferenceProgress p = reference_progress({0, 0.0, 1e-3, 10.0}, 100, 10.5, 4e-3);
+  EXPECT_TRUE(p.reached);
+  EXPECT_TRUE(p.capped);
+  p = reference_progress({0, 0.0, 1e-3, 10.0}, 100, 5.0, 4e-3);
+  EXPECT_FALSE(p.reached);
+  EXPECT_NEAR(p.seconds_left, 5.0, 1e-9);  // the limit comes before the goal's 15 s
+  p = reference_progress({0, 0.0, 1e-3, 10.0}, 100, 5.0, 0.9e-3);
+  EXPECT_TRUE(p.reached);
+  EXPECT_FALSE(p.capped);
+}
+
+TEST(EstimateHistory, TheUnreliableFlagClearsOnceTheEstimateFallsAgain) {
+  EstimateHistory h;
+  // Rare bright paths found between 4 and 8 spp: the estimate does not fall.
+  h.add(2, 0.1);
+  h.add(4, 0.05);
+  h.add(8, 0.06);
+  EXPECT_TRUE(h.unreliable_now());
+  EXPECT_TRUE(h.unreliable());
+  // Then relMSE x spp holds still: the warning clears (the render's record stays).
+  for (std::uint32_t n = 16; n <= 256; n *= 2) h.add(n, 0.48 / n);
+  EXPECT_FALSE(h.unreliable_now());
+  EXPECT_TRUE(h.unreliable());
+}

@@ -132,3 +132,67 @@ TEST(SessionTarget, RaisingTheTargetContinuesWithoutRestart) {
   ASSERT_TRUE(reference.wait_until_done(30s));
   EXPECT_EQ(session.copy_film().mean_rgb(), reference.copy_film().mean_rgb());
 }
+
+TEST(SessionTarget, ATimeLimitStopsAtAPassBoundaryAfterIt) {
+  RenderSession session(2);
+  RenderSettings rs = settings_for(small_scene(32), 0);
+  rs.target_seconds = 0.25;
+  session.set_settings(rs);
+  ASSERT_TRUE(session.wait_until_done(120s));
+  const SessionStats st = session.stats();
+  EXPECT_TRUE(st.done);
+  EXPECT_GE(st.seconds, 0.25);
+  EXPECT_GT(st.spp, 0u);
+  EXPECT_DOUBLE_EQ(st.progress, 1.0);
+  // Stopped: the clock and the film hold still.
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(session.stats().spp, st.spp);
+  EXPECT_DOUBLE_EQ(session.stats().seconds, st.seconds);
+  // A later limit goes on with the same film.
+  const std::uint64_t generation = session.generation();
+  session.set_target_seconds(st.seconds + 0.2);
+  ASSERT_TRUE(session.wait_until_done(120s));
+  EXPECT_EQ(session.generation(), generation);
+  EXPECT_GT(session.stats().spp, st.spp);
+  // The spp target still counts beside it: whichever comes first.
+  RenderSession both(2);
+  rs.target_seconds = 3600.0;
+  rs.target_spp = 3;
+  both.set_settings(rs);
+  ASSERT_TRUE(both.wait_until_done(120s));
+  EXPECT_EQ(both.stats().spp, 3u);
+}
+
+TEST(SessionResume, AFilmsTimeAndSamplesGoOnFromTheFilm) {
+  RenderSession first(2);
+  first.set_settings(settings_for(small_scene(32), 4));
+  ASSERT_TRUE(first.wait_until_done(60s));
+  FilmStart start{first.copy_film(), 4, first.stats().dropped, 30.0};  // as a film saved after 30 s says
+  const std::uint64_t film_samples = 4ull * 32 * 32;
+
+  RenderSession resumed(2);
+  RenderSettings rs = settings_for(small_scene(32), 8);
+  rs.first_sample = 0;
+  resumed.resume(rs, std::move(start));
+  ASSERT_TRUE(resumed.wait_until_done(60s));
+  const SessionStats st = resumed.stats();
+  EXPECT_EQ(st.spp, 8u);
+  // The film's 30 s and its samples are in the figures: per second and efficiency describe the whole film.
+  EXPECT_GE(st.seconds, 30.0);
+  EXPECT_LT(st.seconds, 30.0 + 60.0);
+  EXPECT_EQ(st.samples, 2 * film_samples);
+  EXPECT_NEAR(st.samples_per_second, static_cast<double>(st.samples) / st.seconds, 1e-6 * st.samples_per_second);
+  // A published image says so too.
+  std::vector<float> rgb;
+  ImageInfo info;
+  std::uint64_t version = 0;
+  ASSERT_TRUE(resumed.copy_image(rgb, info, version));
+  EXPECT_GE(info.seconds, 30.0);
+  // A film whose time is not known: this run's clock and samples alone.
+  RenderSession plain(2);
+  plain.resume(settings_for(small_scene(32), 8), FilmStart{resumed.copy_film(), 8, {}, 0.0});
+  plain.set_target_spp(12);
+  ASSERT_TRUE(plain.wait_until_done(60s));
+  EXPECT_EQ(plain.stats().samples, 4ull * 32 * 32);
+  EXPECT_LT(plain.stats().seconds, 30.0);
+}

@@ -328,6 +328,10 @@ TEST(PlotMath, AxesTicksAndColours) {
   EXPECT_EQ(draw::tick_label(1e-3), "0.001");
   EXPECT_EQ(draw::tick_label(1e-4), "1e-04");
   EXPECT_EQ(draw::tick_label(2.5e4), "2e+04");
+  // A decade axis reads 10, 100, 1000, not 1e+03 after 100.
+  EXPECT_EQ(draw::tick_label(100.0), "100");
+  EXPECT_EQ(draw::tick_label(1000.0), "1000");
+  EXPECT_EQ(draw::tick_label(2500.0), "2500");
 
   // The colour map brightens monotonically (reads in grey too).
   float last = -1.0f;
