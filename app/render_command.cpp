@@ -339,11 +339,13 @@ class FilmRender {
     const std::uint32_t had = plan.resumed ? static_cast<std::uint32_t>(plan.resumed->file.info.spp()) : 0;
     settings.target_spp = next_estimate_spp(had, o.spp);
     if (plan.resumed) {
+      // The film's own seconds start the session's clock, so the summary's
+      // time, speed and efficiency describe the whole film, as its spp and
+      // error do (the time of this run alone overstated the efficiency).
       FilmFile& file = plan.resumed->file;
-      seconds_before_ = file.info.seconds;
       const auto had_spp = static_cast<std::uint32_t>(file.info.spp());
       const DropCounts had_drops = file.info.dropped;
-      session_.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops});
+      session_.resume(settings, FilmStart{std::move(file.film), had_spp, had_drops, file.info.seconds});
     } else {
       session_.set_settings(settings);
     }
@@ -356,7 +358,7 @@ class FilmRender {
     FilmInfo now = plan_.info;
     now.ranges = {SampleRange{plan_.seed, plan_.first_sample, plan_.first_sample + spp}};
     now.dropped = dropped;
-    now.seconds = seconds_before_ + seconds;
+    now.seconds = seconds;
     return now;
   }
   FilmInfo save_film(const Film& film, std::uint32_t spp, const DropCounts& dropped, double seconds) const {
@@ -385,7 +387,6 @@ class FilmRender {
   }
   const RenderPlan& plan_;
   RenderSession session_;
-  double seconds_before_ = 0.0;
 };
 
 // Waits for the session, drawing progress, saving checkpoints and stopping on

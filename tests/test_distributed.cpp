@@ -8,7 +8,9 @@
 // sets, recovers too; merge --expect-spp refuses gaps; OpenEXR's exrheader
 // and OpenImageIO's oiiotool read the EXR's layers as the numbers they are.
 #include "renderer/film/exr_io.h"
+#include "renderer/film/film_file.h"
 #include "renderer/film/image_io.h"
+#include "renderer/metrics/metrics.h"
 #include "tests/support.h"
 
 #include <gtest/gtest.h>
@@ -641,6 +643,23 @@ TEST_F(Distributed, ResumeWithoutTheStrategyContinuesTheSameEstimator) {
     // Named again, it is accepted as the film's own.
     ok({"render", "--resume", in_work("half.film"), "--strategy", strategy, "--spp", "16", "--quiet"});
   }
+}
+
+// A resumed render's summary describes the whole film: its time, samples and
+// efficiency include what the film held (they were this run's alone, beside
+// the whole film's spp and error, so the efficiency was overstated).
+TEST_F(Distributed, AResumedRenderCountsTheWholeFilmsTime) {
+  ok(render_args({"--spp", "8", "--film-out", in_work("half.film")}));
+  const double before = read_film_file(in_work("half.film")).info.seconds;
+  ASSERT_GT(before, 0.0);
+  ok({"render", "--resume", in_work("half.film"), "--spp", "16", "--stats-json", in_work("stats.json"), "--quiet"});
+  const nlohmann::json j = nlohmann::json::parse(slurp(in_work("stats.json")));
+  EXPECT_EQ(j.at("samples").get<std::uint64_t>(), 16u * 32u * 24u);
+  const double seconds = j.at("seconds").get<double>();
+  EXPECT_GT(seconds, before);
+  EXPECT_DOUBLE_EQ(read_film_file(in_work("half.film")).info.seconds, seconds);
+  EXPECT_NEAR(j.at("samples_per_second").get<double>(), 16.0 * 32 * 24 / seconds, 1e-6 * 16 * 32 * 24 / seconds);
+  EXPECT_DOUBLE_EQ(j.at("est_efficiency").get<double>(), efficiency(j.at("est_relmse").get<double>(), seconds));
 }
 
 }  // namespace
