@@ -3,8 +3,19 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <utility>
 
 namespace pdflab {
+
+namespace {
+thread_local std::function<bool()> interrupt_check;
+}  // namespace
+
+ScopedRunInterrupt::ScopedRunInterrupt(std::function<bool()> check) : previous_(std::move(interrupt_check)) {
+  interrupt_check = std::move(check);
+}
+
+ScopedRunInterrupt::~ScopedRunInterrupt() { interrupt_check = std::move(previous_); }
 
 MeasuredRun render_measured(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                             const RunLimit& limit, const std::string& label, bool show_progress,
@@ -28,6 +39,7 @@ MeasuredRun render_measured(const std::shared_ptr<const Scene>& scene, const Str
       std::fflush(stderr);
     }
     if (done) break;
+    if (interrupt_check && interrupt_check()) throw RunInterrupted();  // the session stops its workers
     if (limit.seconds > 0 && st.seconds >= limit.seconds) {
       session.set_paused(true);
       break;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 namespace pdflab {
@@ -31,5 +32,26 @@ struct MeasuredRun {
 MeasuredRun render_measured(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                             const RunLimit& limit, const std::string& label, bool show_progress,
                             const std::function<void(RenderSession&)>& on_poll = {});
+
+// Thrown out of a measured run when the check of a ScopedRunInterrupt says
+// stop: its session's workers are stopped and what it rendered is dropped.
+struct RunInterrupted : std::runtime_error {
+  RunInterrupted() : std::runtime_error("interrupted") {}
+};
+
+// While one lives, every measured run on this thread calls `check` at each
+// poll (every 25 ms) and throws RunInterrupted when it says true: how a
+// notebook's Ctrl+C reaches a sweep of many runs, which the command line
+// leaves to the signal's default.
+class ScopedRunInterrupt {
+ public:
+  explicit ScopedRunInterrupt(std::function<bool()> check);
+  ~ScopedRunInterrupt();
+  ScopedRunInterrupt(const ScopedRunInterrupt&) = delete;
+  ScopedRunInterrupt& operator=(const ScopedRunInterrupt&) = delete;
+
+ private:
+  std::function<bool()> previous_;
+};
 
 }  // namespace pdflab

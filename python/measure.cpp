@@ -96,6 +96,23 @@ std::string capture_stdout(const std::string& folder, F&& run) {
   return read_text(path);
 }
 
+// A sweep's or a prediction's runs, stopped by Ctrl+C: each run's poll takes
+// the GIL for a moment to run Python's signal handlers, and a KeyboardInterrupt
+// they raise stops the run in flight and is raised here (with the GIL held
+// again). The stdout capture and the temporary folder are undone on the way.
+template <typename F>
+auto interruptible(F&& run) {
+  const ScopedRunInterrupt scope([] {
+    py::gil_scoped_acquire gil;
+    return PyErr_CheckSignals() != 0;
+  });
+  try {
+    return run();
+  } catch (const RunInterrupted&) {
+    throw py::error_already_set();
+  }
+}
+
 // A scene at the size (and depth) a reference is wanted for, as `pdflab
 // reference` sizes it.
 std::shared_ptr<Scene> sized_scene(const SceneHandle& handle, std::optional<int> width, std::optional<int> height,
@@ -335,11 +352,10 @@ does, or finds the cached one; Reference.load(path) reads a .pfm (with its
         o.quiet = quiet;
         o.auto_weight = auto_weight;
         o.cpu_time = cpu_time;
-        std::string table;
-        {
+        const std::string table = interruptible([&] {
           py::gil_scoped_release release;
-          table = capture_stdout(temp.path(), [&] { (void)run_sweep(o); });
-        }
+          return capture_stdout(temp.path(), [&] { (void)run_sweep(o); });
+        });
         return py::make_tuple(read_text(o.csv), table);
       },
       py::arg("scene"), py::arg("vary"), py::arg("weights"), py::arg("strategy"), py::arg("seconds"), py::arg("spp"),
@@ -379,7 +395,7 @@ does, or finds the cached one; Reference.load(path) reads a .pfm (with its
         double seconds_per_sample = 0.0;
         std::uint32_t pilot_spp = 0;
         CostModel model;
-        {
+        interruptible([&] {
           py::gil_scoped_release release;
           // The pilot's time per sample from a render of its paths (the packet
           // tracer, as any render); then the same samples replayed for their
@@ -399,7 +415,7 @@ does, or finds the cached one; Reference.load(path) reads a .pfm (with its
           // weight's first pass is.
           model = anchored_cost_model(p.sampling_cost, seconds_per_sample, AutoWeight::kPriorOffset);
           if (model.per_ray > 0.0) apply_cost_model(p, model);
-        }
+        });
         py::dict d;
         d["weight"] = p.weight;
         std::vector<std::string> strategies;

@@ -206,7 +206,8 @@ def sweep(scene, vary, weights, *, strategy=None, seconds=None, spp=None, refere
     rows (the columns of `pdflab sweep --csv`, numbers as numbers): a pandas DataFrame when pandas is installed,
     else a list of dicts (frame=False: always the list). The command's summary (best weight, predicted best, cost
     model) is in rows.summary (a DataFrame: .attrs["summary"]); echo=True prints it. progress=True writes a line
-    per run on stderr, as the command does off a terminal.
+    per run on stderr, as the command does off a terminal. Ctrl+C stops the run in flight and raises
+    KeyboardInterrupt (the rows so far are dropped).
     """
     scene = _scene(scene)
     csv_text, summary = _pdflab._sweep(scene, vary, weights, strategy or "", seconds, spp,
@@ -226,7 +227,8 @@ def predict_weights(scene, vary, *, strategy=None, weight=0.5, spp=16, seed=2, r
     weights in [0, 1] (docs/measuring.md), priced by the render's time per sample. Rows: weight, strategy,
     relative_variance (of one sample per pixel), rays_per_sample, efficiency, largest_share (the largest path's
     share of the second moment; above 0.1 the prediction there is unreliable). rows.best_weight (a DataFrame:
-    .attrs) is the predicted best; the other figures are attributes too.
+    .attrs) is the predicted best; the other figures are attributes too. Ctrl+C during the pilot render stops it
+    and raises KeyboardInterrupt (the replay of its paths, a few seconds at most, runs to its end first).
     """
     scene = _scene(scene)
     p = _pdflab._predict_weights(scene, vary, strategy or "", weight, spp, seed, _reference_option(reference), width,

@@ -4,7 +4,11 @@ command line's: the same cache, the same figures."""
 import csv
 import io
 import json
+import os
+import signal
+import subprocess
 import sys
+import time
 import types
 
 import numpy as np
@@ -127,3 +131,39 @@ def test_predict_weights(tmp_path):
     with pytest.raises(ValueError) as e:
         pdflab.predict_weights(SMALL, "cosine,lite", reference=ref)
     assert "lite" in str(e.value)
+
+
+@pytest.mark.parametrize("call", ["sweep", "predict_weights"])
+def test_ctrl_c_stops_a_sweep_and_a_prediction(tmp_path, call):
+    # Each would take minutes: a sweep of 3 weights x 2 seeds at 60 s a run, a
+    # pilot of 2^24 spp. Ctrl+C raises KeyboardInterrupt within a poll, and the
+    # process's stdout is its own again (the sweep's table is captured).
+    script = r"""
+import os, sys, time
+import pdflab
+ref = pdflab.reference(sys.argv[1], spp=16, width=16, height=16, progress=False)
+print("measuring", flush=True)
+try:
+    if sys.argv[2] == "sweep":
+        pdflab.sweep(sys.argv[1], "cosine,light", "0.25:0.75:0.25", seconds=60, seeds=2, reference=ref, threads=1)
+    else:
+        pdflab.predict_weights(sys.argv[1], "cosine,light", spp=1 << 24, reference=ref, threads=1)
+    print("finished", flush=True)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    os.write(1, b"stdout is back\n")
+"""
+    child = subprocess.Popen([sys.executable, "-c", script, SMALL, call], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=os.environ.copy())
+    try:
+        assert child.stdout.readline().strip() == "measuring"
+        time.sleep(1.0)
+        sent = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        out, err = child.communicate(timeout=120)
+        waited = time.monotonic() - sent
+    finally:
+        child.kill()
+    assert child.returncode == 0, err
+    assert out.split() == ["interrupted", "stdout", "is", "back"], (out, err)
+    assert waited < 60, waited
