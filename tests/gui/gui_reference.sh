@@ -3,9 +3,9 @@
 # of its target, 5% of the figures' error) is labelled rough, never measured,
 # and stays out of the cache; with an empty cache the Measure panel shows
 # estimates; M (the Make reference action) renders one to a stated spp in the
-# background with a progress bar, stores it in the cache, and the panel
-# switches to measured figures, which the screenshot's sidecar records with
-# the reference; an orbit of the camera turns them to estimates with the
+# background with a progress bar (Cancel stops one and throws it away), stores
+# it in the cache, and the panel switches to measured figures, which the
+# screenshot's sidecar records with the reference; an orbit of the camera turns them to estimates with the
 # reason, Home measures again; `render --reference auto` and a second viewer
 # find it in the cache; a biased strategy without a reference shows no
 # efficiency.
@@ -85,15 +85,35 @@ reveal measure.plot
 shot estimated
 [ "$(cached)" -eq 0 ] || fail "the cache is not empty before Make reference"
 
-echo "== Make reference to a stated spp (M): a progress bar, then a cached reference and measured figures"
+echo "== Make reference to a stated spp (M): a progress bar, Cancel; then a cached reference and measured figures"
 reveal measure.make_target
 click measure.make_target
 click measure.target.spp
-await_layout "'measure.make_spp' in d['items']"
+# set_make_spp N: the stated spp typed into its field.
+set_make_spp() {
+  click measure.make_spp
+  select_all
+  xdotool type --window "$wid" "$1"
+  send_key Return
+  sleep 0.3
+}
+# A fast machine makes the 1024-spp reference of this 96x96 scene in a fraction
+# of a second, before any capture could see its progress: the progress bar is
+# shot on a reference of 2^20 spp, which no machine finishes while it is
+# watched, and which Cancel then stops and throws away.
+set_make_spp 1048576
 send_key m
-sleep 1.5
+await_layout "'measure.reference_progress' in d['items']"
+sleep 0.5
 shot making
 changed "$art/panel_estimated.png" "$art/panel_making.png" 0.005
+click measure.cancel_reference
+await_layout "'measure.make_reference' in d['items']"
+[ "$(cached)" -eq 0 ] || fail "a cancelled reference went into the cache"
+[ "$(figures)" = estimated ] || fail "figures after a cancelled reference: $(figures)"
+echo "cancelled: no reference cached, the figures still estimates"
+set_make_spp 1024
+send_key m
 for _ in $(seq 120); do [ "$(cached)" -ge 1 ] && break; sleep 0.5; done
 [ "$(cached)" -eq 1 ] || fail "no reference in the cache after Make reference"
 await_layout "d['figures']['source'] == 'measured'"
