@@ -1314,6 +1314,13 @@ void Viewer::Impl::service_auto_weight() {
   session->set_paused(true);
   Film film = session->copy_film();
   const SessionStats st = session->stats();
+  if (settings.stop_spp != 0 && st.spp >= settings.stop_spp) {
+    // The film reached its stop while the image shown lagged a pass behind: no
+    // pass is left to take the new weight, and the film stays as it is.
+    auto_run.history.pop_back();
+    session->set_paused(settings.paused || main_rests_for_reference);
+    return;
+  }
   RenderSettings rs = session->settings();
   settings.sampling.weights[a] = static_cast<float>(w);
   settings.sampling.weights[b] = static_cast<float>(1.0 - w);

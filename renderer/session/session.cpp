@@ -109,6 +109,24 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   next_pass_spp_ = 1;
   preview_due_ = options_.preview;
   pass_.generation = generation_.load();
+  // A film continued at or past its spp target renders no pass, so no pass
+  // would publish it: publish it now as this generation's image, or a viewer
+  // waiting for the new generation's image (a screenshot at --spp N) waits forever.
+  if (start && spp_done_ > 0 && settings_.target_spp != 0 && spp_done_ >= settings_.target_spp) publish_film_locked();
+}
+
+void RenderSession::publish_film_locked() {
+  if (!options_.publish_images) return;
+  spare_rse_.resize(film_.pixel_count());
+  spare_rgb_.resize(3 * film_.pixel_count());
+  noise_ = sweep_noise_rect(film_, 0, 0, film_.width(), film_.height(), kRelMseEpsilon, spare_rse_.data(),
+                            spare_rgb_.data())
+               .summary();
+  spare_drops_ = film_.drop_masks();
+  Pass whole;
+  whole.generation = generation_.load();
+  whole.preview = false;
+  publish_locked(spare_rgb_, whole);
 }
 
 int RenderSession::preview_scale_locked() const {

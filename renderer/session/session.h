@@ -189,6 +189,7 @@ class RenderSession {
   void render_tiles(const Pass& pass, int first, int count, DropCounts& drops);
   void render_preview_tile(const Pass& pass, int tile, DropCounts& drops);
   void publish_locked(std::vector<float>& rgb, const Pass& pass);
+  void publish_film_locked();  // the whole film as a complete pass of this generation
   int preview_scale_locked() const;
   void finish_pass_locked();
   void change_settings(RenderSettings settings, std::optional<FilmStart> start);

@@ -196,3 +196,34 @@ TEST(SessionResume, AFilmsTimeAndSamplesGoOnFromTheFilm) {
   EXPECT_EQ(plain.stats().samples, 4ull * 32 * 32);
   EXPECT_LT(plain.stats().seconds, 30.0);
 }
+
+TEST(SessionResume, AFilmAtItsTargetIsPublishedAtOnce) {
+  // A film continued at (or past) its spp target renders no pass; it is still
+  // this generation's image, or a viewer waiting for one (a screenshot at
+  // --spp N, auto weight continuing a film that just reached its stop) waits forever.
+  RenderSession first(2);
+  first.set_settings(settings_for(small_scene(32), 4));
+  ASSERT_TRUE(first.wait_until_done(60s));
+  const Film film = first.copy_film();
+  std::vector<float> first_rgb;
+  ImageInfo first_info;
+  std::uint64_t first_version = 0;
+  ASSERT_TRUE(first.copy_image(first_rgb, first_info, first_version));
+
+  for (const bool paused : {false, true}) {
+    RenderSession resumed(2);
+    resumed.set_paused(paused);
+    resumed.resume(settings_for(small_scene(32), 4), FilmStart{film, 4, first.stats().dropped, 10.0});
+    ASSERT_TRUE(resumed.wait_until_done(60s));
+    std::vector<float> rgb;
+    ImageInfo info;
+    std::uint64_t version = 0;
+    ASSERT_TRUE(resumed.copy_image(rgb, info, version)) << "paused " << paused;
+    EXPECT_EQ(info.generation, resumed.generation());
+    EXPECT_FALSE(info.preview);
+    EXPECT_EQ(info.spp, 4u);
+    EXPECT_GE(info.seconds, 10.0);
+    EXPECT_EQ(rgb, first_rgb);  // the film's own mean, as the pass that made it published it
+    EXPECT_EQ(resumed.stats().spp, 4u);
+  }
+}
