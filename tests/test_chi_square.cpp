@@ -618,6 +618,36 @@ TEST(ChiSquareVndf, BsdfAloneFromNormalToGrazingAtEveryAlpha) {
   }
 }
 
+// The zoomed harness has the power to see a small error: samples drawn at
+// alpha judged against the density at 1.05 alpha must fail.
+TEST(ChiSquareVndf, RejectsASlightlyWrongDensity) {
+  const Scene scene = *make_scene(Targets::None);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("bsdf"), scene);
+  const Vec3 n(0, 0, 1);
+  for (const float alpha : {1e-3f, 0.1f}) {
+    const Vec3 wo(std::sin(1.0f), 0.0f, std::cos(1.0f));  // 57 degrees
+    const SurfaceLobe drawn{true, alpha, wo}, judged{true, 1.05f * alpha, wo};
+    const Zoom zoom(leaf::reflect(-wo, n), 3.0 * alpha);
+    const Frame frame(Vec3(zoom.axis));
+    auto draw = [&](Rng& rng) {
+      const float u1 = rng.uniform(), u2 = rng.uniform();
+      DirectionSample d = plan.sample_at(drawn, Vec3(0.0f), n, u1, u2, 0, 0);
+      double factor = 1.0;
+      d.direction = zoom.map(d.direction, false, &factor);
+      d.pdf = static_cast<float>(d.pdf * factor);
+      return d;
+    };
+    auto density = [&](const Vec3& zoomed) {
+      double factor = 1.0;
+      const Vec3 d = zoom.map(zoomed, true, &factor);
+      return static_cast<double>(plan.pdf(judged, Vec3(0.0f), n, d)) * factor;
+    };
+    const Outcome o = run_chi_square(frame, draw, density, horizon_reflections(wo, frame, zoom, n), 3650, 400'000);
+    std::printf("[vndf] drawn at alpha %g, judged at 1.05 alpha: p = %.3g\n", alpha, o.chi.p_value);
+    EXPECT_LT(o.chi.p_value, 1e-6) << "alpha " << alpha;
+  }
+}
+
 // Every mixture with bsdf, at a microfacet surface under a sphere target
 // and a quad target (light and light-sa aim at them, bsdf at the lobe).
 TEST(ChiSquareVndf, MixturesWithBsdf) {
