@@ -4,6 +4,7 @@
 #include "app/reference_command.h"
 #include "app/render_command.h"
 #include "app/sweep_command.h"
+#include "app/veach_command.h"
 #include "renderer/error.h"
 #include "renderer/film/film_file.h"
 
@@ -296,6 +297,21 @@ CLI::App* add_sweep_command(CLI::App& app, pdflab::SweepOptions& so) {
   return sweep;
 }
 
+CLI::App* add_veach_command(CLI::App& app, pdflab::VeachOptions& vo) {
+  CLI::App* veach = app.add_subcommand(
+      "veach", "Veach's MIS figure: bsdf, light-sa, nee-mis:balance+bsdf and nee-mis+bsdf at equal time as one 2x2 "
+               "image, and the relMSE of each plate and plate-light pair (docs/veach.md)");
+  veach->add_option("--scene", vo.scene, "Scene file (default: the shipped assets/scenes/veach_mis.json)");
+  add_comparison_inputs(veach, vo, "estimator and seed");
+  veach->add_option("--seeds", vo.seeds, "Seeds per estimator (default 4)")->check(CLI::Range(1, 1000));
+  veach->add_option("--out", vo.out, "The four first-seed renders as one image (.png, .pfm, .exr, .hdr)")->required();
+  veach->add_option("--table", vo.table, "Also write the table (Markdown) here");
+  add_seed_and_threads(veach, vo, "First random seed (default 2; use one the reference was not rendered with)");
+  veach->add_flag("--quiet", vo.quiet, "No progress line");
+  add_roulette_option(veach, vo.roulette_depth);
+  return veach;
+}
+
 // The whole command line: the viewer's options and each command's.
 struct CommandLine {
   ViewerCommand viewer;
@@ -304,7 +320,9 @@ struct CommandLine {
   pdflab::MergeOptions merge;
   pdflab::BenchOptions bench;
   pdflab::SweepOptions sweep;
-  CLI::App *reference_app = nullptr, *merge_app = nullptr, *bench_app = nullptr, *sweep_app = nullptr;
+  pdflab::VeachOptions veach;
+  CLI::App *reference_app = nullptr, *merge_app = nullptr, *bench_app = nullptr, *sweep_app = nullptr,
+           *veach_app = nullptr;
 };
 
 void define_command_line(CLI::App& app, CommandLine& c) {
@@ -316,6 +334,7 @@ void define_command_line(CLI::App& app, CommandLine& c) {
   c.merge_app = add_merge_command(app, c.merge);
   c.bench_app = add_bench_command(app, c.bench);
   c.sweep_app = add_sweep_command(app, c.sweep);
+  c.veach_app = add_veach_command(app, c.veach);
 }
 
 // The exit status when parsing ends the run (help, version, a parse error);
@@ -385,6 +404,11 @@ int run_chosen_command(const CommandLine& c) {
   if (c.bench_app->parsed()) return pdflab::run_bench(c.bench);
   if (c.reference_app->parsed()) return pdflab::run_reference(c.reference);
   if (c.sweep_app->parsed()) return pdflab::run_sweep(c.sweep);
+  if (c.veach_app->parsed()) {
+    pdflab::VeachOptions vo = c.veach;
+    if (vo.scene.empty()) vo.scene = pdflab::asset_dir() + "/scenes/veach_mis.json";
+    return pdflab::run_veach(vo);
+  }
   return run_viewer_command(c.viewer);
 }
 

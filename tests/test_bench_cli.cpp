@@ -343,4 +343,42 @@ TEST_F(BenchCommand, ScenesWithMarkupInTheirNameStillGiveAWellFormedPlot) {
   EXPECT_TRUE(well_formed_xml(slurp(work() / "out.svg")));
 }
 
+// pdflab veach: the four estimators of Veach's figure as one 2x2 image, and
+// the relMSE of every plate and plate-light pair as a Markdown table.
+TEST_F(BenchCommand, VeachWritesTheFigureAndTheTable) {
+  const std::string veach = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/veach_mis.json";
+  const ChildResult ref = run({"render", "--scene", veach, "--strategy", "nee-mis+mix:bsdf=0.5,light-sa=0.5", "--spp",
+                               "256", "--width", "48", "--height", "36", "--seed", "99", "--threads", "2", "--quiet",
+                               "--out", in_work("ref.pfm")});
+  ASSERT_EQ(ref.status, 0) << ref.err;
+  const ChildResult r = run({"veach", "--scene", veach, "--reference", in_work("ref.pfm"), "--spp", "4", "--seeds",
+                             "2", "--out", in_work("panel.png"), "--table", in_work("table.md"), "--threads", "2",
+                             "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string table = slurp(work() / "table.md");
+  EXPECT_EQ(table, r.out);
+  for (const char* needle : {"| power (nee-mis+bsdf) | 4 |", "| alpha 0.005 |", "| alpha 0.2 |",
+                             "| alpha 0.005, radius 0.9 |", "power / best single"})
+    EXPECT_NE(table.find(needle), std::string::npos) << needle << " not in\n" << table;
+  // The PNG's IHDR: 2 x 48 + 4 wide, 2 x 36 + 4 high.
+  const std::string png = slurp(work() / "panel.png");
+  ASSERT_GT(png.size(), 24u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  const auto be32 = [&](std::size_t at) {
+    return (static_cast<unsigned>(static_cast<unsigned char>(png[at])) << 24) |
+           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 1])) << 16) |
+           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 2])) << 8) |
+           static_cast<unsigned>(static_cast<unsigned char>(png[at + 3]));
+  };
+  EXPECT_EQ(be32(16), 100u);
+  EXPECT_EQ(be32(20), 76u);
+  // A scene without a microfacet plate has nothing to measure.
+  const ChildResult book = run({"render", "--scene", kBookScene, "--strategy", "cosine", "--spp", "2", "--width", "8", "--height", "8",
+                                "--seed", "99", "--quiet", "--out", in_work("book.pfm")});
+  ASSERT_EQ(book.status, 0) << book.err;
+  expect_bad_input({"veach", "--scene", kBookScene, "--reference", in_work("book.pfm"), "--spp", "1", "--out",
+                    in_work("book.png")},
+                   "shows no microfacet plate");
+}
+
 }  // namespace

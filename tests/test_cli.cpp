@@ -299,7 +299,7 @@ TEST_F(RenderCommand, TheEstimateVerdictDependsOnTheSamplesNotTheTiming) {
 // Issue 33, item 8: every --reference help names what load_reference reads.
 TEST_F(RenderCommand, EveryReferenceHelpNamesPfmExrAndFilm) {
   for (const std::vector<std::string>& help : {std::vector<std::string>{"--help"}, {"render", "--help"},
-                                               {"bench", "--help"}, {"sweep", "--help"}}) {
+                                               {"bench", "--help"}, {"sweep", "--help"}, {"veach", "--help"}}) {
     const ChildResult r = run(help);
     ASSERT_EQ(r.status, 0) << r.err;
     const std::size_t at = r.out.find("--reference ");

@@ -23,7 +23,8 @@ namespace pdflab {
 namespace {
 
 const char* const kScenes[] = {"cornell_book.json", "small_light.json",  "large_light.json",      "two_lights.json",
-                               "far_light.json",    "glossy_metal.json", "cornell_aluminium.json"};
+                               "far_light.json",    "glossy_metal.json", "cornell_aluminium.json",
+                               "veach_mis.json"};
 // The strategies of the options and their combinations; every technique of
 // the table, alone and mixed with cosine, is added (tests/table_strategies.h).
 const char* const kStrategies[] = {"mix:cosine=0.5,light=0.5",
@@ -36,6 +37,8 @@ const char* const kStrategies[] = {"mix:cosine=0.5,light=0.5",
                                    "cosine+rr:1",
                                    "nee-mis+rr",
                                    "nee-mis+mix:cosine=0.5,light=0.5",
+                                   "nee-mis+bsdf",
+                                   "nee-mis:balance+mix:bsdf=0.5,light-sa=0.5+rr:2",
                                    "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2",
                                    "nee-mis+mix:uniform-sphere=0.5,light=0.5",
                                    "fastest",

@@ -541,5 +541,53 @@ TEST(SceneSyntax, NotAnObject) {
   EXPECT_NE(message.find("top level"), std::string::npos) << message;
 }
 
+// ---- The microfacet conductor -------------------------------------------------
+
+json with_microfacet(const json& material) {
+  json doc = minimal_scene();
+  doc["materials"]["rough"] = material;
+  doc["objects"][0]["material"] = "rough";
+  return doc;
+}
+
+TEST(SceneLoader, MicrofacetLoads) {
+  const json doc = with_microfacet(json::parse(
+      R"({"type": "microfacet", "alpha": 0.2, "eta": [1.657, 0.88, 0.521], "k": [9.224, 6.27, 4.837]})"));
+  const Scene s = load_scene_text(doc.dump(), "scene.json");
+  const Material& m = s.materials[s.spheres[0].material];
+  EXPECT_EQ(m.type, MaterialType::Microfacet);
+  EXPECT_FLOAT_EQ(m.alpha, 0.2f);
+  EXPECT_FLOAT_EQ(m.eta.y, 0.88f);
+  EXPECT_FLOAT_EQ(m.k.z, 4.837f);
+  // A conductor is no light target and no specular object.
+  EXPECT_EQ(s.targets.size(), 1u);
+}
+
+TEST(SceneLoader, MicrofacetRefusesBadParameters) {
+  const json good = json::parse(R"({"type": "microfacet", "alpha": 0.2, "eta": [1, 1, 1], "k": [3, 3, 3]})");
+  for (const double alpha : {0.0, -0.1, 0.0005, 1.5}) {
+    json m = good;
+    m["alpha"] = alpha;
+    expect_error_mentions(with_microfacet(m), {"materials.rough.alpha", "0.001..1"});
+  }
+  json m = good;
+  m["eta"] = {1, 0, 1};
+  expect_error_mentions(with_microfacet(m), {"materials.rough.eta", "> 0"});
+  m = good;
+  m["k"] = {1, -1, 1};
+  expect_error_mentions(with_microfacet(m), {"materials.rough.k", ">= 0"});
+  for (const char* key : {"alpha", "eta", "k"}) {
+    m = good;
+    m.erase(key);
+    expect_error_mentions(with_microfacet(m), {"missing key", key});
+  }
+  m = good;
+  m["fuzz"] = 0.1;
+  expect_error_mentions(with_microfacet(m), {"unknown key 'fuzz'", "alpha, eta, k, type"});
+  m = good;
+  m["type"] = "microfacets";
+  expect_error_mentions(with_microfacet(m), {"unknown material type", "microfacet)"});
+}
+
 }  // namespace
 }  // namespace pdflab

@@ -20,7 +20,9 @@ ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t see
     const Material& m = scene.materials[hit.material];
     const bool front = dot(ray.direction, hit.normal) < 0.0f;
     const Vec3 n = front ? hit.normal : -hit.normal;
-    if (m.type == MaterialType::Lambertian) {
+    // A microfacet conductor is a diffuse vertex too: the strategy draws there
+    // (the probe shows its techniques as at a lambertian point).
+    if (m.type == MaterialType::Lambertian || m.type == MaterialType::Microfacet) {
       at.found = true;
       at.point = diffuse_origin(hit, n);  // where its rays leave from
       at.normal = n;

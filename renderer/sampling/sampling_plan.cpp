@@ -129,6 +129,32 @@ float SamplingPlan::pdf(const Vec3& origin, const Vec3& normal, const Vec3& dire
   return leaf::mixture_pdf(*this, at, direction, true);
 }
 
+namespace {
+void set_surface(leaf::Shading& at, const SurfaceLobe& surface) {
+  at.glossy = surface.glossy;
+  at.alpha = surface.alpha;
+  at.outgoing = surface.outgoing;
+}
+}  // namespace
+
+float SamplingPlan::pdf(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal,
+                        const Vec3& direction) const {
+  leaf::Shading at(*this, origin, normal, 0.0f, 0.0f, 0);
+  set_surface(at, surface);
+  return leaf::mixture_pdf(*this, at, direction, true);
+}
+
+DirectionSample SamplingPlan::sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1,
+                                        float u2, std::uint32_t u_technique, std::uint32_t u_target,
+                                        int* technique) const {
+  const int chosen = leaf::choose_technique(*this, static_cast<std::int32_t>(u_technique));
+  if (technique) *technique = chosen;
+  const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(u_target) : 0;
+  leaf::Shading at(*this, origin, normal, u1, u2, u_choice);
+  set_surface(at, surface);
+  return to_direction_sample(leaf::sample_mixture(*this, at, chosen, true));
+}
+
 bool SamplingPlan::stratifies(int depth) const { return sobol && depth >= 0 && depth < qmc::kDepths; }
 
 DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique,

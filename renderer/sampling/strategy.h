@@ -121,6 +121,15 @@ inline Strategy with_roulette(Strategy strategy, int depth) {
   return strategy;
 }
 
+// The surface a continuation is drawn at, for the `bsdf` technique: lambertian
+// (its lobe is the cosine lobe), or a microfacet conductor of GGX roughness
+// `alpha` seen from `outgoing` (unit, on the normal's side).
+struct SurfaceLobe {
+  bool glossy = false;
+  float alpha = 1.0f;
+  Vec3 outgoing{0.0f, 0.0f, 1.0f};
+};
+
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
 // distribution, and the target sets. Built once per render; it points into the
 // scene, which must outlive it and stay where it is.
@@ -173,9 +182,14 @@ struct SamplingPlan {
   // technique against one's own inverse CDF at the very same numbers.
   DirectionSample sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2, std::uint32_t u_technique,
                             std::uint32_t u_target, int* technique = nullptr) const;
+  // The same at a given surface (the `bsdf` technique's lobe there).
+  DirectionSample sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1, float u2,
+                            std::uint32_t u_technique, std::uint32_t u_target, int* technique = nullptr) const;
   // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
             float aimed_t = 0.0f) const;
+  // The mixture's pdf at a given surface.
+  float pdf(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, const Vec3& direction) const;
 
   // The steps of make, once `scene` is set: the target sets; then the
   // strategy's techniques (for nee-mis, its continuation's) with their

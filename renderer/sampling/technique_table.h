@@ -16,6 +16,7 @@
 #include "renderer/sampling/techniques/cosine_power.inc"
 #include "renderer/sampling/techniques/specular_objects.inc"
 #include "renderer/sampling/techniques/uniform_cone.inc"
+#include "renderer/sampling/techniques/bsdf.inc"
 
 #elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
 #define PDFLAB_TECHNIQUE_TABLE_H
@@ -29,7 +30,8 @@
   X(LightSolidAngle)         \
   X(CosinePower)             \
   X(SpecularObjects)         \
-  X(UniformCone)
+  X(UniformCone)             \
+  X(Bsdf)
 
 #include <array>
 #include <cstdint>

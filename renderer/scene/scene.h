@@ -9,7 +9,10 @@
 
 namespace pdflab {
 
-enum class MaterialType : std::uint8_t { Lambertian, Metal, Dielectric, DiffuseLight };
+// Microfacet: a rough conductor (GGX / Trowbridge-Reitz normals of roughness
+// `alpha`, the exact conductor Fresnel of the complex index eta + i k per
+// channel, height-correlated Smith masking-shadowing), reflecting only.
+enum class MaterialType : std::uint8_t { Lambertian, Metal, Dielectric, DiffuseLight, Microfacet };
 
 struct Material {
   MaterialType type = MaterialType::Lambertian;
@@ -18,7 +21,16 @@ struct Material {
   float fuzz = 0.0f;
   float ior = 1.0f;
   bool two_sided = false;  // diffuse_light only
+  // microfacet only: GGX roughness and the conductor's complex index of
+  // refraction (relative to the air outside), per channel.
+  float alpha = 1.0f;
+  Vec3 eta{1.0f};
+  Vec3 k{0.0f};
 };
+
+// The microfacet roughness range the loader accepts: below 1e-3 the lobe is
+// narrower than float resolves around the mirror direction.
+inline constexpr float kMinMicrofacetAlpha = 1e-3f;
 
 // A parallelogram: corner q, edges u and v. Front face normal is u x v.
 struct Quad {

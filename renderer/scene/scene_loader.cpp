@@ -156,8 +156,22 @@ Material parse_material(const Node& node) {
     m.type = MaterialType::DiffuseLight;
     m.emit = nonnegative_colour(node.require("emit"));
     m.two_sided = node.has("two_sided") && node.child("two_sided").boolean();
+  } else if (type == "microfacet") {
+    node.allow_only({"type", "alpha", "eta", "k"});
+    m.type = MaterialType::Microfacet;
+    const Node alpha = node.require("alpha");
+    m.alpha = alpha.real();
+    if (!(m.alpha >= kMinMicrofacetAlpha && m.alpha <= 1.0f)) alpha.fail("must be in 0.001..1 (the GGX roughness)");
+    const Node eta = node.require("eta");
+    m.eta = eta.vec3();
+    if (!(m.eta.x > 0.0f && m.eta.y > 0.0f && m.eta.z > 0.0f))
+      eta.fail("components must be > 0 (the real part of the conductor's index of refraction)");
+    const Node k = node.require("k");
+    m.k = k.vec3();
+    if (!(m.k.x >= 0.0f && m.k.y >= 0.0f && m.k.z >= 0.0f))
+      k.fail("components must be >= 0 (the imaginary part of the conductor's index of refraction)");
   } else {
-    type_node.fail("unknown material type '" + type + "' (lambertian, metal, dielectric, diffuse_light)");
+    type_node.fail("unknown material type '" + type + "' (lambertian, metal, dielectric, diffuse_light, microfacet)");
   }
   return m;
 }
