@@ -162,6 +162,8 @@ struct PacketDraws {
       for (PlanDraw& d : draws) {
         d.point = origin, d.normal = normal;
         d.u0 = rng.next_u32(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.next_u32();
+        // u1's last cell drawn further (used by the techniques that draw the tail).
+        if (d.u1 == kLargestUniform) d.top_log2 = uniform_tail_log2([&] { return rng.next_u32(); });
       }
       batch.resize(kBatch);
       sample_plan(best_packet_isa(), *plan, draws.data(), draws.size(), batch.data());
