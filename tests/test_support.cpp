@@ -197,6 +197,64 @@ TEST(Support, TailDrawsTheLastCellWithRelativePrecision) {
   }
 }
 
+// The limit itself, where the missing directions carry the light: a floor of
+// albedo 0.5 under a band of light just above its horizon (cos theta in
+// [2^-10, 2^-8.5], 0.22 to 0.06 degrees up) and a sky of 1 elsewhere, seen
+// by cosine-power:2 alone (unbiased, finite variance) and mixed with
+// uniform-cone:85 (which does not reach the band). The plain 24-bit warp
+// stopped at cos = 2^-8, above the band: it converged to the sky alone. Every
+// draw that reaches the band has u1 = 1 - 2^-24, one draw in 2^24, so a plain
+// average would need some 10^9 draws to see it; the estimator's expectation is
+// measured instead with u1's last cell as a stratum of its own (probability
+// 2^-24, its draws with u1 = 1 - 2^-24 and the tail from the stream, as the
+// tracers draw it), the rest as the other: the same limit, within 3 standard
+// errors of the exact value, and the undrawn tail (log2(1 - u1) = -24, what
+// the 24-bit warp did) caught far outside them.
+TEST(Support, CosinePowerSeesLightJustAboveTheHorizon) {
+  constexpr double kAlbedo = 0.5, c1 = 0x1.0p-10, c2 = 0.0027621358640099515;  // 2^-10, 2^-8.5
+  // The band's radiance: half the floor's light comes from it.
+  const double band = 1.0 + 1.0 / (c2 * c2 - c1 * c1);
+  const double exact = kAlbedo * (1.0 + (band - 1.0) * (c2 * c2 - c1 * c1));  // rho / pi * E, E = pi sum L c^2
+  auto radiance = [&](double cosine) { return cosine >= c1 && cosine < c2 ? band : 1.0; };
+  for (const char* text : {"cosine-power:2", "mix:cosine-power:2=0.5,uniform-cone:85=0.5"}) {
+    const SamplingPlan plan = SamplingPlan::make(Strategy::parse(text), book());
+    struct Mean {
+      double sum = 0, sum2 = 0;
+      int n = 0;
+      void add(double x) { sum += x, sum2 += x * x, ++n; }
+      double mean() const { return sum / n; }
+      double variance_of_mean() const { return (sum2 / n - mean() * mean()) / (n - 1); }
+    };
+    // One estimate: the floor's radiance rho / pi * L cos / p from one draw.
+    auto estimate = [&](float u1, float u2, std::uint32_t u0, float top_log2) {
+      const DirectionSample s = plan.sample_at(kPoint, kUp, u1, u2, u0, 0, nullptr, top_log2);
+      if (s.none || !(s.direction.z > 0.0f)) return 0.0;
+      return kAlbedo / std::numbers::pi * radiance(s.direction.z) * s.direction.z / s.pdf;
+    };
+    Rng rng(11, 11);
+    Mean rest, last, last_undrawn;
+    constexpr int kDraws = 1 << 20;
+    for (int i = 0; i < kDraws; ++i) {
+      float u1 = rng.uniform();
+      while (u1 == kLargestUniform) u1 = rng.uniform();
+      rest.add(estimate(u1, rng.uniform(), rng.next_u32(), -24.0f));
+      const float u2 = rng.uniform();
+      const std::uint32_t u0 = rng.next_u32();
+      const float top_log2 = uniform_tail_log2([&] { return rng.next_u32(); });
+      last.add(estimate(kLargestUniform, u2, u0, top_log2));
+      last_undrawn.add(estimate(kLargestUniform, u2, u0, -24.0f));
+    }
+    const double p_last = 0x1.0p-24, p_rest = 1.0 - p_last;
+    const double value = p_rest * rest.mean() + p_last * last.mean();
+    const double se = std::sqrt(p_rest * p_rest * rest.variance_of_mean() + p_last * p_last * last.variance_of_mean());
+    const double plain = p_rest * rest.mean() + p_last * last_undrawn.mean();
+    std::printf("%s: exact %.6f, drawn tail %.6f +- %.6f (z %.2f), 24-bit warp %.6f (z %.1f)\n", text, exact, value,
+                se, (value - exact) / se, plain, (plain - exact) / se);
+    EXPECT_LT(std::fabs(value - exact), 3.0 * se) << text;
+    EXPECT_GT(std::fabs(plain - exact), 20.0 * se) << text;  // the old limit is caught
+  }
+}
+
 // The tail's draws give the packet kernel the one-path code's bits, alone and
 // in a mixture, over the whole range of log2(1 - u1).
 TEST(Support, TailDrawsAreTheSameBitsInPackets) {
