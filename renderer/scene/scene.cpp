@@ -186,10 +186,15 @@ void Scene::prepare() {
   //    4 eps t + 8 eps m. A ground sphere through the scene's origin (m = 0),
   //    whose float error is a fixed fraction of its radius where everything
   //    else is small, keeps the double test.
+  //  - its radius is at most 2^57: the test squares |f| <= 56 r, which stays
+  //    below FLT_MAX (2^128) only up to r = 2^58; above, r^2 overflowed to inf
+  //    and every ray missed (a dome of radius 1.84e19 or more was invisible).
+  //    The double test holds every radius the loader accepts (r^2 <= 1e77).
   for (Sphere& sp : spheres) {
     const double centre = std::sqrt(static_cast<double>(dot(sp.center, sp.center)));
     const double smallest = std::fabs(centre - static_cast<double>(sp.radius)) / std::sqrt(3.0);
-    sp.float_test = s <= 16.0f * sp.radius && static_cast<double>(sp.radius) <= 2.0 * smallest;
+    sp.float_test = s <= 16.0f * sp.radius && static_cast<double>(sp.radius) <= 2.0 * smallest &&
+                    sp.radius <= kLargestFloatTestRadius;
   }
 }
 

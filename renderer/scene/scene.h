@@ -31,6 +31,10 @@ struct Quad {
   std::uint32_t material;
 };
 
+// The largest radius a sphere is intersected in float at (Scene::prepare):
+// the float test squares lengths up to 56 radii, which overflow above 2^58.
+inline constexpr float kLargestFloatTestRadius = 0x1.0p57f;
+
 struct Sphere {
   Vec3 center;
   float radius;
