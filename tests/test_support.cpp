@@ -69,6 +69,14 @@ double support_edge(const SamplingPlan& plan) {
   return std::exp2(hi);
 }
 
+// The cosine of a drawn direction with +z, in double: from its part across
+// the normal where it is near the normal (float's z has steps of 6e-8 there).
+double cosine_of(const Vec3& d) {
+  const double x = d.x, y = d.y, z = d.z, n2 = x * x + y * y + z * z;
+  if (std::fabs(z) * std::fabs(z) < 0.25 * n2) return z / std::sqrt(n2);
+  return std::copysign(std::sqrt(std::max(0.0, 1.0 - (x * x + y * y) / n2)), z);
+}
+
 struct Reach {
   double smallest = 2.0, largest = -2.0;  // cos(theta) of the draws with a direction
 };
@@ -81,8 +89,8 @@ Reach reach(const SamplingPlan& plan) {
   auto take = [&](float u1, float u2, float top_log2) {
     const DirectionSample s = plan.sample_at(kPoint, kUp, u1, u2, 0, 0, nullptr, top_log2);
     if (s.none) return;
-    r.smallest = std::min(r.smallest, static_cast<double>(s.direction.z));
-    r.largest = std::max(r.largest, static_cast<double>(s.direction.z));
+    r.smallest = std::min(r.smallest, cosine_of(s.direction));
+    r.largest = std::max(r.largest, cosine_of(s.direction));
   };
   for (const float u2 : {0.0f, kLargestUniform}) {
     take(0.0f, u2, -24.0f);
