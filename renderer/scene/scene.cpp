@@ -203,6 +203,13 @@ namespace {
 Hit quad_hit(const Quad& q, const Ray& ray, float t) {
   return {t, ray.origin + ray.direction * t, q.normal, q.material, leaf::quad_hit_error(ray.origin, q.plane_d, t)};
 }
+// The hit on sphere s at distance t; its normal faces the ray where the sphere
+// is tiny beside the distance (kFarSphere, as PathTracer::gather).
+Hit sphere_hit(const Sphere& s, const Ray& ray, float t) {
+  const Vec3 point = ray.origin + ray.direction * t;
+  const Vec3 normal = t > kFarSphere * s.radius ? -ray.direction : (point - s.center) * (1.0f / s.radius);
+  return {t, point, normal, s.material, leaf::sphere_hit_error(ray.origin, t, point, s.float_radius())};
+}
 }  // namespace
 
 bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
@@ -229,12 +236,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     }
   }
   if (best_sphere >= 0) {
-    const Sphere& s = scene.spheres[best_sphere];
-    hit.t = closest;
-    hit.point = ray.origin + ray.direction * closest;
-    hit.normal = (hit.point - s.center) * (1.0f / s.radius);
-    hit.material = s.material;
-    hit.error = leaf::sphere_hit_error(ray.origin, closest, hit.point, s.float_radius());
+    hit = sphere_hit(scene.spheres[best_sphere], ray, closest);
     return true;
   }
   if (best_quad >= 0) {
@@ -247,7 +249,9 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
 bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit) {
   if (aimed_quad < 0) return intersect(scene, ray, kInf, hit);
   if (intersect(scene, ray, distance * kAimedReach, hit)) return true;
-  hit = quad_hit(scene.quads[static_cast<std::size_t>(aimed_quad)], ray, distance);
+  const auto nq = static_cast<int>(scene.quads.size());
+  hit = aimed_quad < nq ? quad_hit(scene.quads[static_cast<std::size_t>(aimed_quad)], ray, distance)
+                        : sphere_hit(scene.spheres[static_cast<std::size_t>(aimed_quad - nq)], ray, distance);
   return true;
 }
 
