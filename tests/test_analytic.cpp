@@ -11,8 +11,10 @@
 // Each pixel's exact value is averaged over the pixel's footprint (the camera
 // jitters inside the pixel) in double. Every strategy, rendered through the
 // session (the packet tracer), must land within 3 standard errors of the exact
-// image at scene scales from 1e-3 to 1e6 and lights down to 1e-5 of the scene,
-// including shading points nearly in the light's plane.
+// image at scene scales from 1e-3 to 1e6, quad lights down to 1e-5 of the scene
+// and sphere lights down to 1e-9 of it (rays aimed at a sphere that float
+// cannot aim at reach it: the aimed-ray rule), including shading points
+// nearly in the light's plane.
 #include "renderer/integrator/integrator.h"
 #include "renderer/scene/scene_loader.h"
 
@@ -306,10 +308,12 @@ std::vector<Param> cases() {
   for (const double scale : {1e-3, 1.0, 1e3, 1e6}) {
     char sc[16];
     std::snprintf(sc, sizeof sc, "s%g", scale);
-    for (const double size : {1e-1, 1e-3, 1e-5}) {
+    for (const double size : {1e-1, 1e-3, 1e-5, 1e-7, 1e-9}) {
       char sz[16];
       std::snprintf(sz, sizeof sz, "%g", size);
       for (const LightShape shape : {LightShape::Quad, LightShape::Sphere}) {
+        // Sphere lights down to 1e-9 of their distance (the aimed-ray rule's).
+        if (size < 1e-5 && shape == LightShape::Quad) continue;
         AnalyticCase c;
         c.scale = scale;
         c.shape = shape;
@@ -322,6 +326,7 @@ std::vector<Param> cases() {
           for (const auto& s : blind_strategies)
             out.push_back({c, s, blind_spp(s)});
       }
+      if (size < 1e-5) continue;
       // A quad barely above the floor, behind the camera: every floor point in
       // view is nearly in the light's plane and sees it at a grazing angle.
       AnalyticCase g;

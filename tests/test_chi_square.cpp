@@ -18,7 +18,9 @@
 #include <cstdio>
 #include <deque>
 #include <memory>
+#include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pdflab {
@@ -30,7 +32,12 @@ using chi_square::Sampler;
 using chi_square::target_outlines;
 
 // 20 x 40 cells of equal solid angle (dz dphi = 0.1 * 2pi/40 = pi/200 sr each).
-const chi_square::Grid kGrid{20, 40};
+// Rows of equal mass where a lobe is narrow (chi_square::follow_lobe).
+const chi_square::Grid kGrid = [] {
+  chi_square::Grid g{20, 40};
+  g.lobe_rows = true;
+  return g;
+}();
 constexpr int kSamples = 1'000'000;
 constexpr double kFamilyAlpha = 0.01;
 
@@ -257,6 +264,16 @@ const std::vector<ChiCase>& table_cases() {
           texts.push_back(mixed ? "mix:" + partner + "=0.5," + std::string(t.name) + "=0.5" : std::string(t.name));
           out.push_back({name, texts.back().c_str(), p.targets, p.origin, p.normal});
         }
+        // Alone at its parameter's ends too (the narrowest lobe, the widest).
+        if (!t.parameter.empty())
+          for (const auto& [end, value] : {std::pair{"min", t.parameter_min}, std::pair{"max", t.parameter_max}}) {
+            texts.push_back("table_" + id + "_" + end + "_" + p.name);
+            const char* name = texts.back().c_str();
+            char text[64];
+            std::snprintf(text, sizeof text, "%s:%g", std::string(t.name).c_str(), static_cast<double>(value));
+            texts.push_back(text);
+            out.push_back({name, texts.back().c_str(), p.targets, p.origin, p.normal});
+          }
       }
     }
     return out;
@@ -333,7 +350,8 @@ void expect_follows_pdf(const ChiCase& c, const Outcome& o) {
 
 TEST_P(ChiSquare, SamplesFollowPdf) {
   const ChiCase& c = every_case()[GetParam()];
-  expect_follows_pdf(c, run_case(c, 1000 + static_cast<std::uint64_t>(GetParam())));
+  const Outcome o = run_case(c, 1000 + static_cast<std::uint64_t>(GetParam()));
+  expect_follows_pdf(c, o);
 }
 
 // The same through the packet kernel's sampler, the code that renders.
@@ -358,7 +376,8 @@ TEST_P(ChiSquare, PdfIntegratesToOne) {
   const Frame frame(p.normal);
   auto density = [&](const Vec3& d) { return case_density(c, p, d); };
   double total = 0.0;
-  for (double m : chi_square::cell_masses(kGrid, frame, density, chi_square::plan_edges(p.plan, p.origin, p.normal, frame)))
+  const chi_square::Grid grid = chi_square::follow_lobe(kGrid, frame, density);  // as check_plan's
+  for (double m : chi_square::cell_masses(grid, frame, density, chi_square::plan_edges(p.plan, p.origin, p.normal, frame)))
     total += m;
   std::printf("[integral] %-40s %.8f\n", c.name, total);
   EXPECT_NEAR(total, 1.0, 2e-4);
@@ -412,6 +431,44 @@ TEST(ChiSquareHarness, FlagsSamplesWherePdfIsZero) {
   auto density = [&](const Vec3& d) { return static_cast<double>(uniform_hemisphere_pdf(n, d)); };
   const Outcome o = run_chi_square(frame, sampler, density, {}, 8, 10'000);
   EXPECT_GT(o.chi.zero_cell_hits, 4000u);
+}
+
+// A wrong warp inside a narrow lobe: directions uniform in theta within a 10
+// degree cone, judged against the cone's pdf (uniform in solid angle, so in
+// cos theta). The whole cone lies in the first of 20 rows of equal cos width,
+// where only azimuths are tested: the plain grid passes it. follow_lobe's
+// rows of equal mass cut the cone into 20 and reject it; the right warp passes.
+TEST(ChiSquareHarness, RejectsAWrongWarpInsideANarrowCone) {
+  const Vec3 n(0, 0, 1);
+  const Frame frame(n);
+  Strategy strategy = Strategy::parse("uniform-cone:10");
+  const std::unique_ptr<Scene> scene = make_scene(Targets::Sphere);
+  const SamplingPlan plan = SamplingPlan::make(strategy, *scene);
+  const double theta_max = 10.0 * std::numbers::pi / 180.0;
+  auto wrong = [&](Rng& rng) {
+    const double theta = theta_max * rng.uniform(), phi = 2.0 * std::numbers::pi * rng.uniform();
+    const Vec3 d(static_cast<float>(std::sin(theta) * std::cos(phi)), static_cast<float>(std::sin(theta) * std::sin(phi)),
+                 static_cast<float>(std::cos(theta)));
+    return DirectionSample{d, plan.pdf(Vec3(0.0f), n, d)};
+  };
+  auto density = [&](const Vec3& d) { return static_cast<double>(plan.pdf(Vec3(0.0f), n, d)); };
+  const std::vector<chi_square::Point> edges = chi_square::technique_edges(plan, n, frame);
+  const chi_square::Grid plain{20, 40};
+  const chi_square::Grid rows = chi_square::follow_lobe(plain, frame, density);
+  ASSERT_GE(rows.z_cells, 20);
+  EXPECT_GT(rows.z_edges[19], std::cos(theta_max) - 1e-3);  // 20 rows inside the cone
+  const double alpha = 1e-3;
+  const Outcome blind = chi_square::run(plain, frame, wrong, density, edges, 21, 100'000);
+  const Outcome sharp = chi_square::run(rows, frame, wrong, density, edges, 21, 100'000);
+  std::printf("uniform in theta in a 10 degree cone: plain rows p = %.3g, rows of equal mass p = %.3g\n",
+              blind.chi.p_value, sharp.chi.p_value);
+  EXPECT_TRUE(blind.passed(alpha));  // what the harness could not see
+  EXPECT_FALSE(sharp.passed(alpha));
+  EXPECT_LT(sharp.chi.p_value, 1e-12);
+  // The right warp, the technique's own sampler, passes on the same rows.
+  const Outcome right = chi_square::run(rows, frame, chi_square::plan_sampler(plan, Vec3(0.0f), n, Sampler::OnePath),
+                                        density, edges, 22, 100'000);
+  EXPECT_TRUE(right.passed(alpha)) << right.chi.p_value;
 }
 
 // A subtle error: light samples judged against the pdf of the same quad moved

@@ -510,3 +510,42 @@ TEST(Extremes, NoShippedSceneDropsASample) {
 
 }  // namespace
 }  // namespace pdflab
+
+namespace pdflab {
+namespace {
+
+// A ball of albedo 0.5 inside a two-sided emitting dome of radius R (emission
+// 1): the ball's radiance is exactly 0.5 (it sees only the dome), the dome's
+// 1. The float sphere test squared the radius past FLT_MAX from R = 1.84e19
+// (2^64), and the dome vanished: a black image. Every radius the loader
+// accepts, up to 1e30, now renders the closed form: cosine exactly (its weight
+// is the albedo), nee-mis and light-sa (the dome, their target, sampled from
+// inside it: the whole sphere of directions) within 3 standard errors.
+TEST(Extremes, BallInsideADomeOfAnyRadius) {
+  for (const double radius : {1.8e19, 1.85e19, 1e20, 1e25, 1e30}) {
+    char text[1024];
+    std::snprintf(text, sizeof text, R"({
+      "camera": {"width": 9, "height": 9, "vfov": 30, "lookfrom": [0, 0, -5], "lookat": [0, 0, 0], "max_depth": 4},
+      "materials": {"ball": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]},
+                    "dome": {"type": "diffuse_light", "emit": [1, 1, 1], "two_sided": true}},
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "ball"},
+                  {"type": "sphere", "center": [0, 0, 0], "radius": %.17g, "material": "dome", "importance": true}]})",
+                  radius);
+    auto scene = std::make_shared<Scene>(load_scene_text(text, "dome.json"));
+    const std::size_t centre = 4 * 9 + 4, corner = 0;
+    for (const char* strategy : {"cosine", "nee-mis", "light-sa"}) {
+      const Rendered r = render(scene, strategy, strategy == std::string("cosine") ? 4u : 256u);
+      EXPECT_EQ(r.stats.dropped.total(), 0u) << strategy << " R = " << radius;
+      double m[3], v[3];
+      r.film.mean(corner, m);
+      EXPECT_NEAR(m[0], 1.0, 1e-6) << strategy << " R = " << radius << ": the dome";
+      r.film.mean(centre, m);
+      r.film.variance_of_mean(centre, v);
+      if (strategy == std::string("cosine")) EXPECT_NEAR(m[0], 0.5, 1e-6) << "R = " << radius;
+      else EXPECT_NEAR(m[0], 0.5, 3.0 * std::sqrt(v[0]) + 1e-6) << strategy << " R = " << radius;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pdflab

@@ -74,6 +74,9 @@ struct PlanDraw {
   std::uint32_t u0;  // the technique's 32 random bits
   float u1, u2;
   std::uint32_t u_choice;  // the target's
+  // log2(1 - u1) where u1 is its largest value (kLargestUniform) and the
+  // technique draws the tail (leaf::Shading::top_log2); -24: undrawn.
+  float top_log2 = -24.0f;
 };
 void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out);
 // The mixture's density for `directions[i]` at draws[i]'s point (its random numbers unused).

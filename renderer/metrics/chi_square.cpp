@@ -18,8 +18,16 @@ using glm::dvec3;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
+int row_index(const Grid& g, double z) {
+  if (g.z_edges.empty()) return std::clamp(static_cast<int>((1.0 - z) * 0.5 * g.z_cells), 0, g.z_cells - 1);
+  // The first row whose lower edge is at or below z (edges descend).
+  const auto it = std::upper_bound(g.z_edges.begin() + 1, g.z_edges.end(), z, std::greater<double>());
+  const auto row = static_cast<int>(it - (g.z_edges.begin() + 1));
+  return std::clamp(row, 0, g.z_cells - 1);
+}
+
 int cell_index(const Grid& g, const Point& q) {
-  const int row = std::clamp(static_cast<int>((1.0 - q.z) * 0.5 * g.z_cells), 0, g.z_cells - 1);
+  const int row = row_index(g, q.z);
   const int col = std::clamp(static_cast<int>(q.phi / kTwoPi * g.phi_cells), 0, g.phi_cells - 1);
   return row * g.phi_cells + col;
 }
@@ -32,6 +40,9 @@ struct Rect {
 
 Rect cell_rect(const Grid& g, int cell) {
   const int row = cell / g.phi_cells, col = cell % g.phi_cells;
+  const auto r = static_cast<std::size_t>(row);
+  if (!g.z_edges.empty())
+    return {g.z_edges[r + 1], g.z_edges[r], kTwoPi * col / g.phi_cells, kTwoPi * (col + 1) / g.phi_cells};
   return {1.0 - 2.0 * (row + 1) / g.z_cells, 1.0 - 2.0 * row / g.z_cells, kTwoPi * col / g.phi_cells,
           kTwoPi * (col + 1) / g.phi_cells};
 }
@@ -162,6 +173,8 @@ struct PacketDraws {
       for (PlanDraw& d : draws) {
         d.point = origin, d.normal = normal;
         d.u0 = rng.next_u32(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.next_u32();
+        // u1's last cell drawn further (used by the techniques that draw the tail).
+        if (d.u1 == kLargestUniform) d.top_log2 = uniform_tail_log2([&] { return rng.next_u32(); });
       }
       batch.resize(kBatch);
       sample_plan(best_packet_isa(), *plan, draws.data(), draws.size(), batch.data());
@@ -263,6 +276,67 @@ std::vector<Point> plan_edges(const SamplingPlan& plan, const Vec3& origin, cons
   return edges;
 }
 
+Grid follow_lobe(const Grid& grid, const Frame& frame, const Density& density) {
+  // The marginal in theta on steps theta_i = pi (i / M)^2 (finest at the
+  // normal: 4.7e-8 rad there, 7.7e-4 at the antipode), each step's mass by
+  // the midpoint rule over K azimuths.
+  constexpr int M = 8192, K = 32;
+  std::vector<double> z(M + 1), mass(M);
+  for (int i = 0; i <= M; ++i) {
+    const double a = static_cast<double>(i) / M;
+    z[static_cast<std::size_t>(i)] = std::cos(std::numbers::pi * a * a);
+  }
+  z[M] = -1.0;
+  double cos_p[K], sin_p[K];
+  for (int j = 0; j < K; ++j) {
+    cos_p[j] = std::cos(kTwoPi * (j + 0.5) / K);
+    sin_p[j] = std::sin(kTwoPi * (j + 0.5) / K);
+  }
+  double total = 0.0;
+  for (int i = 0; i < M; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double zm = 0.5 * (z[k] + z[k + 1]);
+    double sum = 0.0;
+    for (int j = 0; j < K; ++j) sum += density(frame.direction(zm, cos_p[j], sin_p[j]));
+    mass[k] = sum / K * kTwoPi * (z[k] - z[k + 1]);
+    total += mass[k];
+  }
+  if (!(total > 0.0)) return grid;
+  // The uniform rows' largest share.
+  std::vector<double> row_mass(static_cast<std::size_t>(grid.z_cells), 0.0);
+  Grid uniform = grid;
+  uniform.z_edges.clear();
+  for (int i = 0; i < M; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    row_mass[static_cast<std::size_t>(row_index(uniform, 0.5 * (z[k] + z[k + 1])))] += mass[k];
+  }
+  if (*std::max_element(row_mass.begin(), row_mass.end()) <= 0.25 * total) return grid;
+  // Rows of equal mass: an edge where the running mass passes each quantile.
+  std::vector<double> edges{1.0};
+  double running = 0.0;
+  int next = 1;
+  for (int i = 0; i < M && next < grid.z_cells; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    running += mass[k];
+    while (next < grid.z_cells && running >= total * next / grid.z_cells) {
+      if (z[k + 1] < edges.back()) edges.push_back(z[k + 1]);
+      ++next;
+    }
+  }
+  // Below the lobe, rows that double in width down to -1: a lobe's tail in
+  // one row as wide as the rest of the sphere would be integrated from a few
+  // points far from where its mass is.
+  if (edges.size() >= 2) {
+    const double width = edges[edges.size() - 2] - edges.back();
+    for (double step = 2.0 * width; edges.back() - step > -1.0; step *= 2.0) edges.push_back(edges.back() - step);
+  }
+  if (edges.back() > -1.0) edges.push_back(-1.0);
+  Grid out = grid;
+  out.z_cells = static_cast<int>(edges.size()) - 1;
+  out.z_edges = std::move(edges);
+  return out;
+}
+
 std::vector<double> cell_masses(const Grid& grid, const Frame& frame, const Density& density,
                                 const std::vector<Point>& edges) {
   const CellIntegrator integrator(grid, frame, density, edges);
@@ -338,7 +412,8 @@ std::vector<Outcome> check_plan(const SamplingPlan& plan, const Vec3& origin, co
   const std::vector<Point> edges = plan_edges(plan, origin, normal, frame);
   std::vector<Draw> draws;
   for (Sampler which : samplers) draws.push_back(plan_sampler(plan, origin, normal, which));
-  return run_each(grid, frame, draws, density, edges, seed, samples);
+  const Grid rows = grid.lobe_rows && grid.z_edges.empty() ? follow_lobe(grid, frame, density) : grid;
+  return run_each(rows, frame, draws, density, edges, seed, samples);
 }
 
 Outcome check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which, int samples,

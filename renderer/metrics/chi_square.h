@@ -21,9 +21,16 @@
 namespace pdflab::chi_square {
 
 // Rows of equal cos(theta) width from +1 (row 0, the normal) down to -1, and
-// columns of equal azimuth from 0 to 2 pi.
+// columns of equal azimuth from 0 to 2 pi; or, where `z_edges` is given, rows
+// between those cosines (z_cells + 1 of them, from 1 down to -1).
 struct Grid {
+  Grid() = default;
+  Grid(int z, int phi) : z_cells(z), phi_cells(phi) {}
   int z_cells = 20, phi_cells = 40;
+  std::vector<double> z_edges;
+  // check_plan gives a narrow lobe rows of equal mass (follow_lobe; the
+  // outcome's grid then says which rows, and may have more than z_cells).
+  bool lobe_rows = false;
   int cells() const { return z_cells * phi_cells; }
 };
 
@@ -58,6 +65,16 @@ std::vector<Point> technique_edges(const SamplingPlan& plan, const Vec3& normal,
 // Everything above for a plan: its scene's targets' outlines and its
 // techniques' own edges.
 std::vector<Point> plan_edges(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, const Frame& frame);
+
+// Rows that follow a narrow lobe. Rows of equal cos(theta) width are blind to
+// how a lobe narrower than one row is drawn inside it (a 10 degree cone lies
+// in the first of 20 rows: only its azimuths were tested). Where one of
+// `grid`'s rows holds more than a quarter of the density's mass, this gives
+// the grid rows of equal mass instead (the quantiles of the density's
+// marginal in theta, integrated on a grid that is finest at the normal), so a
+// lobe of any width is cut into z_cells rows, and rows below it that double in
+// width down to -1; else `grid` itself.
+Grid follow_lobe(const Grid& grid, const Frame& frame, const Density& density);
 
 // The pdf integrated over each cell (probability, not counts), row-major.
 // Measured over the test suite's cases, the sphere's total is off by at most
@@ -95,7 +112,9 @@ enum class Sampler { OnePath, Packet };
 Draw plan_sampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which);
 
 // The whole check of a plan's mixture at a shading point: the outlines of the
-// plan's scene's targets, the mixture's pdf, the chosen sampler.
+// plan's scene's targets and its techniques' own edges, the mixture's pdf, the
+// chosen sampler, on `grid`'s rows or, where it asks for them (lobe_rows) and
+// the lobe is narrow, rows of equal mass (follow_lobe).
 Outcome check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which, int samples,
                    std::uint64_t seed, const Grid& grid = {});
 // ... for several samplers, in that order, against one integration.

@@ -1,6 +1,7 @@
 #pragma once
 // Deterministic random numbers. A sample's stream depends only on
 // (seed, pixel, sample index), never on which thread renders it.
+#include <cmath>
 #include <cstdint>
 
 // Always inlined where it runs on vectors: in the packet tracer it then
@@ -93,5 +94,30 @@ class Rng {
   std::uint64_t increment_;  // odd; selects the stream
   std::uint64_t state_;
 };
+
+// u1's last cell refined. Rng::uniform's 24 bits put 1 - u1 on a grid of
+// 2^-24, so a warp that raises 1 - u1 to a small power (cosine-power's
+// (1 - u1)^(1 / (N + 1))) never reaches the directions that 1 - u1 < 2^-24
+// maps to. Where u1 is the largest value (kLargestUniform: 1 - u1 = 2^-24, the
+// cell (0, 2^-24]), this draws the point within that cell with relative
+// precision: 2^-(k + 1) (1 + m 2^-32), k geometric (the zero bits before the
+// first one bit, up to kTailWords words of them) and m the next word, and
+// returns log2(1 - u1) itself, -24 - (k + 1) + log2(1 + m 2^-32), down to
+// -281 (every bit zero). `next` gives 32 random bits; it is called at most
+// kTailWords + 1 times, and the same numbers give the same value in every
+// tracer (one scalar formula).
+inline constexpr float kLargestUniform = 1.0f - 0x1.0p-24f;
+inline constexpr int kTailWords = 8;
+template <class Next>
+float uniform_tail_log2(Next next) {
+  int zeros = 0;
+  std::uint32_t word = 0;
+  for (int i = 0; i < kTailWords && word == 0; ++i) {
+    word = next();
+    zeros += word == 0 ? 32 : __builtin_clz(word);
+  }
+  const std::uint32_t mantissa = next();
+  return static_cast<float>(-24.0 - (zeros + 1) + std::log2(1.0 + static_cast<double>(mantissa) * 0x1.0p-32));
+}
 
 }  // namespace pdflab

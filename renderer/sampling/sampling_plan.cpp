@@ -146,12 +146,13 @@ float SamplingPlan::pdf(const SurfaceLobe& surface, const Vec3& origin, const Ve
 
 DirectionSample SamplingPlan::sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1,
                                         float u2, std::uint32_t u_technique, std::uint32_t u_target,
-                                        int* technique) const {
+                                        int* technique, float top_log2) const {
   const int chosen = leaf::choose_technique(*this, static_cast<std::int32_t>(u_technique));
   if (technique) *technique = chosen;
   const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(u_target) : 0;
   leaf::Shading at(*this, origin, normal, u1, u2, u_choice);
   set_surface(at, surface);
+  at.top_log2 = top_log2;
   return to_direction_sample(leaf::sample_mixture(*this, at, chosen, true));
 }
 
@@ -175,15 +176,20 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
   const std::uint32_t u_target = leaf::draws_target(*this, chosen) ? rng.next_u32() : 0;
-  return sample_at(origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target);
+  // u1's last cell drawn further where the technique needs it (path.inc's order).
+  const float top_log2 = leaf::draws_tail(*this, chosen, u1) ? uniform_tail_log2([&] { return rng.next_u32(); }) : -24.0f;
+  return sample_at(origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2);
 }
 
 DirectionSample SamplingPlan::sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2,
-                                        std::uint32_t u_technique, std::uint32_t u_target, int* technique) const {
+                                        std::uint32_t u_technique, std::uint32_t u_target, int* technique,
+                                        float top_log2) const {
   const int chosen = leaf::choose_technique(*this, static_cast<std::int32_t>(u_technique));
   if (technique) *technique = chosen;
   const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(u_target) : 0;
-  return to_direction_sample(leaf::sample_mixture(*this, leaf::Shading(*this, origin, normal, u1, u2, u_choice), chosen, true));
+  leaf::Shading at(*this, origin, normal, u1, u2, u_choice);
+  at.top_log2 = top_log2;
+  return to_direction_sample(leaf::sample_mixture(*this, at, chosen, true));
 }
 
 }  // namespace pdflab

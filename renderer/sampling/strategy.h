@@ -180,11 +180,14 @@ struct SamplingPlan {
   // for the direction, 32 bits for the choice of the technique and 32 for the
   // target (used only where the chosen technique draws one). For checking a
   // technique against one's own inverse CDF at the very same numbers.
+  // `top_log2`: log2(1 - u1) where u1 is its largest value (kLargestUniform)
+  // and the technique draws the tail (leaf::Shading::top_log2; -24: undrawn).
   DirectionSample sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2, std::uint32_t u_technique,
-                            std::uint32_t u_target, int* technique = nullptr) const;
+                            std::uint32_t u_target, int* technique = nullptr, float top_log2 = -24.0f) const;
   // The same at a given surface (the `bsdf` technique's lobe there).
   DirectionSample sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1, float u2,
-                            std::uint32_t u_technique, std::uint32_t u_target, int* technique = nullptr) const;
+                            std::uint32_t u_technique, std::uint32_t u_target, int* technique = nullptr,
+                            float top_log2 = -24.0f) const;
   // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
             float aimed_t = 0.0f) const;

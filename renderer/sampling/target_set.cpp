@@ -30,7 +30,8 @@ float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const vo
     if (e.quad != skip)
       sum += e.probability * leaf::quad_area_pdf(*e.quad, origin, direction, e.index == aimed_quad, aimed_t);
   for (const SphereEntry& e : spheres)
-    if (e.sphere != skip) sum += e.probability * sphere_cone_pdf(*e.sphere, origin, direction);
+    if (e.sphere != skip)
+      sum += e.probability * leaf::sphere_cone_pdf(*e.sphere, origin, direction, e.index == aimed_quad);
   return sum;
 }
 
@@ -57,7 +58,9 @@ DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, fl
     ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.quad);
   } else {
     const SphereEntry& e = spheres[chosen - nq];
-    ds = sample_sphere_cone(*e.sphere, origin, u1, u2);
+    float sin_phi, cos_phi;
+    sincos_2pi(u2, sin_phi, cos_phi);
+    ds = to_direction_sample(leaf::sample_sphere_cone(*e.sphere, origin, u1, sin_phi, cos_phi, e.index));
     ds.pdf = e.probability * ds.pdf + pdf_without(origin, ds.direction, e.sphere);
   }
   return ds;
@@ -80,7 +83,7 @@ std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pic
   for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
     const Sphere& sp = scene.spheres[i];
     if (!pick(Target{Target::Kind::Sphere, static_cast<std::uint32_t>(i)})) continue;
-    set.spheres.push_back({&sp, 0.0f});
+    set.spheres.push_back({&sp, 0.0f, static_cast<std::int32_t>(scene.quads.size() + i)});
     const double area = 4.0 * std::numbers::pi * static_cast<double>(sp.radius) * sp.radius;
     sphere_power.push_back(emitter_power(scene.materials[sp.material], area));
   }

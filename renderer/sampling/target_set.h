@@ -23,6 +23,9 @@ struct TargetSet {
   struct SphereEntry {
     const Sphere* sphere;
     float probability;
+    // Its row among the scene's objects, Scene::quads.size() + its index in
+    // Scene::spheres: the id a ray aimed at it carries (Sampled::aimed_quad).
+    std::int32_t index;
   };
   std::vector<QuadEntry> quads;
   std::vector<SphereEntry> spheres;

@@ -186,10 +186,15 @@ void Scene::prepare() {
   //    4 eps t + 8 eps m. A ground sphere through the scene's origin (m = 0),
   //    whose float error is a fixed fraction of its radius where everything
   //    else is small, keeps the double test.
+  //  - its radius is at most 2^57: the test squares |f| <= 56 r, which stays
+  //    below FLT_MAX (2^128) only up to r = 2^58; above, r^2 overflowed to inf
+  //    and every ray missed (a dome of radius 1.84e19 or more was invisible).
+  //    The double test holds every radius the loader accepts (r^2 <= 1e77).
   for (Sphere& sp : spheres) {
     const double centre = std::sqrt(static_cast<double>(dot(sp.center, sp.center)));
     const double smallest = std::fabs(centre - static_cast<double>(sp.radius)) / std::sqrt(3.0);
-    sp.float_test = s <= 16.0f * sp.radius && static_cast<double>(sp.radius) <= 2.0 * smallest;
+    sp.float_test = s <= 16.0f * sp.radius && static_cast<double>(sp.radius) <= 2.0 * smallest &&
+                    sp.radius <= kLargestFloatTestRadius;
   }
 }
 
@@ -197,6 +202,13 @@ namespace {
 // The hit on quad q at distance t along the ray.
 Hit quad_hit(const Quad& q, const Ray& ray, float t) {
   return {t, ray.origin + ray.direction * t, q.normal, q.material, leaf::quad_hit_error(ray.origin, q.plane_d, t)};
+}
+// The hit on sphere s at distance t; its normal faces the ray where the sphere
+// is tiny beside the distance (kFarSphere, as PathTracer::gather).
+Hit sphere_hit(const Sphere& s, const Ray& ray, float t) {
+  const Vec3 point = ray.origin + ray.direction * t;
+  const Vec3 normal = t > kFarSphere * s.radius ? -ray.direction : (point - s.center) * (1.0f / s.radius);
+  return {t, point, normal, s.material, leaf::sphere_hit_error(ray.origin, t, point, s.float_radius())};
 }
 }  // namespace
 
@@ -224,12 +236,7 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
     }
   }
   if (best_sphere >= 0) {
-    const Sphere& s = scene.spheres[best_sphere];
-    hit.t = closest;
-    hit.point = ray.origin + ray.direction * closest;
-    hit.normal = (hit.point - s.center) * (1.0f / s.radius);
-    hit.material = s.material;
-    hit.error = leaf::sphere_hit_error(ray.origin, closest, hit.point, s.float_radius());
+    hit = sphere_hit(scene.spheres[best_sphere], ray, closest);
     return true;
   }
   if (best_quad >= 0) {
@@ -242,7 +249,9 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
 bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit) {
   if (aimed_quad < 0) return intersect(scene, ray, kInf, hit);
   if (intersect(scene, ray, distance * kAimedReach, hit)) return true;
-  hit = quad_hit(scene.quads[static_cast<std::size_t>(aimed_quad)], ray, distance);
+  const auto nq = static_cast<int>(scene.quads.size());
+  hit = aimed_quad < nq ? quad_hit(scene.quads[static_cast<std::size_t>(aimed_quad)], ray, distance)
+                        : sphere_hit(scene.spheres[static_cast<std::size_t>(aimed_quad - nq)], ray, distance);
   return true;
 }
 

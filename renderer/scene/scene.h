@@ -43,6 +43,10 @@ struct Quad {
   std::uint32_t material;
 };
 
+// The largest radius a sphere is intersected in float at (Scene::prepare):
+// the float test squares lengths up to 56 radii, which overflow above 2^58.
+inline constexpr float kLargestFloatTestRadius = 0x1.0p57f;
+
 struct Sphere {
   Vec3 center;
   float radius;
@@ -149,5 +153,10 @@ bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit);
 bool intersect_aimed(const Scene& scene, const Ray& ray, int aimed_quad, float distance, Hit& hit);
 // How far beyond the aimed point the search goes, relative to the distance.
 inline constexpr float kAimedReach = 1.0f + 0x1.0p-12f;
+// A sphere hit from more than this many radii away: the hit point's rounding
+// (a few 2^-24 of the distance) may exceed the radius, so (point - centre) / r
+// is no normal; the hit faces the ray (the origin is far outside), and its
+// normal is taken as -direction (a light 1e-9 of its distance across).
+inline constexpr float kFarSphere = 65536.0f;
 
 }  // namespace pdflab
