@@ -7,9 +7,21 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pdflab::testing {
+
+// A PNG file's width and height, from its IHDR; (0, 0) where it is no PNG.
+inline std::pair<unsigned, unsigned> png_size(const std::string& png) {
+  if (png.size() < 24 || png.substr(1, 3) != "PNG") return {0u, 0u};
+  const auto be32 = [&](std::size_t at) {
+    unsigned v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(png[at + i]);
+    return v;
+  };
+  return {be32(16), be32(20)};
+}
 
 class CommandTest : public ::testing::Test {
  protected:

@@ -30,6 +30,7 @@ void write_text(const fs::path& path, const std::string& text) {
 
 using pdflab::testing::ChildResult;
 using pdflab::testing::slurp;
+using pdflab::testing::png_size;
 
 std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> parts;
@@ -361,17 +362,7 @@ TEST_F(BenchCommand, VeachWritesTheFigureAndTheTable) {
                              "| alpha 0.005, radius 0.9 |", "power / best single"})
     EXPECT_NE(table.find(needle), std::string::npos) << needle << " not in\n" << table;
   // The PNG's IHDR: 2 x 48 + 4 wide, 2 x 36 + 4 high.
-  const std::string png = slurp(work() / "panel.png");
-  ASSERT_GT(png.size(), 24u);
-  EXPECT_EQ(png.substr(1, 3), "PNG");
-  const auto be32 = [&](std::size_t at) {
-    return (static_cast<unsigned>(static_cast<unsigned char>(png[at])) << 24) |
-           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 1])) << 16) |
-           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 2])) << 8) |
-           static_cast<unsigned>(static_cast<unsigned char>(png[at + 3]));
-  };
-  EXPECT_EQ(be32(16), 100u);
-  EXPECT_EQ(be32(20), 76u);
+  EXPECT_EQ(png_size(slurp(work() / "panel.png")), std::make_pair(100u, 76u));
   // A scene without a microfacet plate has nothing to measure.
   const ChildResult book = run({"render", "--scene", kBookScene, "--strategy", "cosine", "--spp", "2", "--width", "8", "--height", "8",
                                 "--seed", "99", "--quiet", "--out", in_work("book.pfm")});

@@ -623,6 +623,23 @@ std::vector<chi_square::Point> horizon_reflections(const Vec3& wo, const Frame& 
   return out;
 }
 
+// A draw seen through the zoom: its direction mapped, its pdf times the map's Jacobian.
+DirectionSample through_zoom(const Zoom& zoom, DirectionSample d) {
+  double factor = 1.0;
+  d.direction = zoom.map(d.direction, false, &factor);
+  d.pdf = static_cast<float>(d.pdf * factor);
+  return d;
+}
+
+// The density of `surface`'s plan at a zoomed direction: p(d) times the
+// zoom's Jacobian p'(d') / p(d) at the pair.
+double density_through_zoom(const SamplingPlan& plan, const SurfaceLobe& surface, const Vec3& origin, const Vec3& n,
+                            const Zoom& zoom, const Vec3& zoomed) {
+  double factor = 1.0;
+  const Vec3 d = zoom.map(zoomed, true, &factor);
+  return static_cast<double>(plan.pdf(surface, origin, n, d)) * factor;
+}
+
 // A plan's draw at a microfacet surface, zoomed, against its pdf, zoomed.
 Outcome glossy_check(const SamplingPlan& plan, const Vec3& origin, const Vec3& n, const GlossyCase& c,
                      std::uint64_t seed, bool with_targets) {
@@ -636,18 +653,9 @@ Outcome glossy_check(const SamplingPlan& plan, const Vec3& origin, const Vec3& n
     const std::uint32_t u0 = rng.next_u32();
     const float u1 = rng.uniform(), u2 = rng.uniform();
     const std::uint32_t u3 = rng.next_u32();
-    DirectionSample d = plan.sample_at(surface, origin, n, u1, u2, u0, u3);
-    double factor = 1.0;
-    d.direction = zoom.map(d.direction, false, &factor);
-    d.pdf = static_cast<float>(d.pdf * factor);
-    return d;
+    return through_zoom(zoom, plan.sample_at(surface, origin, n, u1, u2, u0, u3));
   };
-  auto density = [&](const Vec3& zoomed) {
-    double factor = 1.0;
-    const Vec3 d = zoom.map(zoomed, true, &factor);
-    // factor: p'(d') / p(d), the zoom's Jacobian at the pair.
-    return static_cast<double>(plan.pdf(surface, origin, n, d)) * factor;
-  };
+  auto density = [&](const Vec3& zoomed) { return density_through_zoom(plan, surface, origin, n, zoom, zoomed); };
   std::vector<chi_square::Point> edges = horizon_reflections(wo, frame, zoom, n);
   if (with_targets) {
     // The targets' outlines, traced about the unzoomed frame, then zoomed.
@@ -688,17 +696,9 @@ TEST(ChiSquareVndf, RejectsASlightlyWrongDensity) {
     const Frame frame(Vec3(zoom.axis));
     auto draw = [&](Rng& rng) {
       const float u1 = rng.uniform(), u2 = rng.uniform();
-      DirectionSample d = plan.sample_at(drawn, Vec3(0.0f), n, u1, u2, 0, 0);
-      double factor = 1.0;
-      d.direction = zoom.map(d.direction, false, &factor);
-      d.pdf = static_cast<float>(d.pdf * factor);
-      return d;
+      return through_zoom(zoom, plan.sample_at(drawn, Vec3(0.0f), n, u1, u2, 0, 0));
     };
-    auto density = [&](const Vec3& zoomed) {
-      double factor = 1.0;
-      const Vec3 d = zoom.map(zoomed, true, &factor);
-      return static_cast<double>(plan.pdf(judged, Vec3(0.0f), n, d)) * factor;
-    };
+    auto density = [&](const Vec3& zoomed) { return density_through_zoom(plan, judged, Vec3(0.0f), n, zoom, zoomed); };
     const Outcome o = run_chi_square(frame, draw, density, horizon_reflections(wo, frame, zoom, n), 3650, 400'000);
     std::printf("[vndf] drawn at alpha %g, judged at 1.05 alpha: p = %.3g\n", alpha, o.chi.p_value);
     EXPECT_LT(o.chi.p_value, 1e-6) << "alpha " << alpha;

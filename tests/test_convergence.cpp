@@ -273,6 +273,16 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
 namespace pdflab {
 namespace {
 
+// A shipped scene at 24x24 (the convergence tests' size) with at most `depth` segments a path.
+std::shared_ptr<Scene> small_shipped_scene(const char* file, int depth) {
+  auto scene = std::make_shared<Scene>(load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file));
+  scene->camera.width = 24;
+  scene->camera.height = 24;
+  scene->max_depth = depth;
+  scene->prepare();
+  return scene;
+}
+
 // max_depth means the same for every strategy: a path has at most max_depth
 // segments, the camera ray included (max_depth 1: the lights seen directly;
 // 2: direct light; 3: one indirect bounce). Next-event estimation's shadow ray
@@ -284,11 +294,7 @@ TEST(Convergence, MaxDepthMeansTheSameForEveryStrategy) {
   const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
   std::uint64_t seed = 900;
   for (const int depth : {1, 2, 3}) {
-    auto scene = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/small_light.json"));
-    scene->camera.width = kSmall;
-    scene->camera.height = kSmall;
-    scene->max_depth = depth;
-    scene->prepare();
+    const auto scene = small_shipped_scene("small_light.json", depth);
     const BlockImage reference = render_blocks("mix:cosine=0.5,light=0.5", seed++, 2048, scene);
     for (const char* strategy : strategies) {
       SCOPED_TRACE(std::string(strategy) + " at max_depth " + std::to_string(depth));
@@ -369,11 +375,7 @@ TEST(Convergence, VeachSceneEveryUnbiasedStrategyAgrees) {
   // The scene's depth (2: direct light, Veach's figure), and 5: light between
   // the plates and the backdrop, microfacet vertices past the first, roulette.
   for (const int depth : {2, 5}) {
-    auto scene = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/veach_mis.json"));
-    scene->camera.width = kSmall;
-    scene->camera.height = kSmall;
-    scene->max_depth = depth;
-    scene->prepare();
+    const auto scene = small_shipped_scene("veach_mis.json", depth);
     const BlockImage reference = render_blocks("nee-mis+mix:bsdf=0.5,light-sa=0.5", seed++, 8192, scene);
     for (const Run& run : runs) {
       SCOPED_TRACE(std::string(run.strategy) + " at max_depth " + std::to_string(depth));

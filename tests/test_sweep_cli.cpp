@@ -24,6 +24,7 @@ const std::string kBookScene = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/
 
 using pdflab::testing::ChildResult;
 using pdflab::testing::slurp;
+using pdflab::testing::png_size;
 
 // One CSV line into fields; a field in double quotes may hold commas.
 std::vector<std::string> csv_fields(const std::string& line) {
@@ -203,17 +204,7 @@ TEST_F(SweepCommand, TinySweepWritesOneRowPerWeight) {
   EXPECT_NE(svg.find("weight of cosine"), std::string::npos);
   EXPECT_NE(svg.find("predicted from w = 0.5"), std::string::npos);
   // The map: a PNG of the reference's size times 6, plus its scale bar.
-  const std::string png = slurp(in_work("map.png"));
-  ASSERT_GT(png.size(), 24u);
-  EXPECT_EQ(png.substr(1, 3), "PNG");
-  const auto be32 = [&](std::size_t at) {
-    return (static_cast<unsigned>(static_cast<unsigned char>(png[at])) << 24) |
-           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 1])) << 16) |
-           (static_cast<unsigned>(static_cast<unsigned char>(png[at + 2])) << 8) |
-           static_cast<unsigned>(static_cast<unsigned char>(png[at + 3]));
-  };
-  EXPECT_EQ(be32(16), 12u * 6u);
-  EXPECT_EQ(be32(20), 8u * 6u + 4u + 16u);
+  EXPECT_EQ(png_size(slurp(in_work("map.png"))), std::make_pair(12u * 6u, 8u * 6u + 4u + 16u));
   EXPECT_NE(r.out.find("predicted best weight"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("best fixed weight's efficiency, fairly"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cost model: seconds per sample"), std::string::npos) << r.out;
