@@ -969,6 +969,7 @@ ui::ScreenshotData Viewer::Impl::capture() const {
   d.generation = image_info.generation;
   if (render_scene) {
     d.camera = render_scene->camera;
+    d.origin = render_scene->origin;
     d.scene_hash = render_scene->content_hash;
   }
   d.camera_moved = camera.has_value();

@@ -10,6 +10,7 @@
 
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cmath>
 
 namespace pdflab::python {
@@ -221,7 +222,10 @@ then the direction and pdf are 0).)");
           if (!normal) throw InputError("chi_square: a point (x, y, z) needs its normal");
           if (normal->size() != 3) throw InputError("chi_square: the normal must have 3 components");
           at.found = true;
-          at.point = Vec3(static_cast<float>(point[0]), static_cast<float>(point[1]), static_cast<float>(point[2]));
+          // In the scene file's coordinates: into the rendering space (Scene::origin).
+          const std::array<double, 3> origin = p.keep ? p.keep->origin : std::array<double, 3>{};
+          at.point = Vec3(static_cast<float>(point[0] - origin[0]), static_cast<float>(point[1] - origin[1]),
+                          static_cast<float>(point[2] - origin[2]));
           at.normal = unit(Vec3(static_cast<float>((*normal)[0]), static_cast<float>((*normal)[1]),
                                 static_cast<float>((*normal)[2])),
                            "normal", 0);
@@ -249,7 +253,12 @@ then the direction and pdf are 0).)");
         d["empty_samples"] = packet.empty_samples;
         d["bad_pdf"] = packet.bad_pdf + one_path.bad_pdf;
         d["zero_cell_hits"] = packet.chi.zero_cell_hits + one_path.chi.zero_cell_hits;
-        d["point"] = std::vector<double>{at.point.x, at.point.y, at.point.z};
+        if (p.keep) {
+          const auto in_file = file_point(*p.keep, at.point);
+          d["point"] = std::vector<double>{in_file[0], in_file[1], in_file[2]};
+        } else {
+          d["point"] = std::vector<double>{at.point.x, at.point.y, at.point.z};
+        }
         d["normal"] = std::vector<double>{at.normal.x, at.normal.y, at.normal.z};
         const auto rows = static_cast<py::ssize_t>(z_cells), cols = static_cast<py::ssize_t>(phi_cells);
         py::array_t<std::uint64_t> observed({rows, cols});

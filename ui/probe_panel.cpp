@@ -342,8 +342,10 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
     ImGui::End();
     return;
   }
-  ImGui::TextColored(kDim, "hit (%.0f, %.0f, %.0f)  normal (%.2f, %.2f, %.2f)%s", s.point.point.x, s.point.point.y,
-                     s.point.point.z, s.point.normal.x, s.point.normal.y, s.point.normal.z,
+  // In the scene file's coordinates (the rendering space may be the camera's).
+  const auto hit = file_point(*s.scene, s.point.point);
+  ImGui::TextColored(kDim, "hit (%.6g, %.6g, %.6g)  normal (%.2f, %.2f, %.2f)%s", hit[0], hit[1], hit[2],
+                     s.point.normal.x, s.point.normal.y, s.point.normal.z,
                      s.point.specular_bounces ? "  after mirror/glass" : "");
 
   const float line = ImGui::GetTextLineHeight();

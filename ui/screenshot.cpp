@@ -52,8 +52,12 @@ std::string screenshot_sidecar(const ScreenshotData& d, const SavedScreenshot& p
       weights[std::string(technique_name(static_cast<Technique>(i)))] = d.strategy.weights[i] / total;
   j["weights"] = weights;
   const auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
-  j["camera"] = {{"lookfrom", vec(d.camera.lookfrom)},
-                 {"lookat", vec(d.camera.lookat)},
+  const auto in_file = [&](const Vec3& v) {
+    return nlohmann::json::array({static_cast<double>(v.x) + d.origin[0], static_cast<double>(v.y) + d.origin[1],
+                                  static_cast<double>(v.z) + d.origin[2]});
+  };
+  j["camera"] = {{"lookfrom", in_file(d.camera.lookfrom)},
+                 {"lookat", in_file(d.camera.lookat)},
                  {"vup", vec(d.camera.vup)},
                  {"vfov", d.camera.vfov_degrees},
                  {"moved", d.camera_moved}};

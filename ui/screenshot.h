@@ -7,6 +7,7 @@
 #include "renderer/scene/scene.h"
 #include "ui/measure.h"
 
+#include <array>
 #include <cstdint>
 #include <ctime>
 #include <string>
@@ -28,7 +29,8 @@ struct ScreenshotData {
   int max_depth = 0;
   std::string version;
   std::uint64_t generation = 0;  // not in the sidecar: which render the viewer saved
-  Camera camera;                 // as rendered
+  Camera camera;                 // as rendered, in the rendering space
+  std::array<double, 3> origin{};  // Scene::origin: the sidecar gives the camera in the file's coordinates
   bool camera_moved = false;     // moved in the viewer, not the scene file's
   std::string scene_hash;        // of the view rendered (the camera too when moved): a reference's identity
   // The figures shown for the image, and what they were measured against.

@@ -3,6 +3,7 @@
 // rotations/translations are baked into the geometry by the loader.
 #include "renderer/math.h"
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -110,6 +111,20 @@ struct QuadBatch {
   void build(const std::vector<struct Quad>& quads);
 };
 
+// The rendering space moves to the camera where the camera is more than this
+// many times further from the scene file's origin than from what it sees (the
+// nearest object, or lookat if nearer): float's steps grow with the
+// coordinates, 0.06 at 1e6, so a room 1 across placed 1e6 from the origin
+// would be rendered with the precision of a room 1e-6 across. The book's
+// scenes, their cameras a few times their own size from the origin, keep the
+// file's coordinates and their bits.
+inline constexpr double kCameraCentredRatio = 64.0;
+// A box is refused where float cannot place its faces: its smallest side
+// spans fewer than this many float steps of its coordinates in the rendering
+// space (its faces, each rounded on its own, would then miss each other by
+// more than 1/64 of the box).
+inline constexpr double kSmallestBoxSteps = 64.0;
+
 struct Scene {
   std::string name;
   // Of the scene file's content without the image size, the depth and the
@@ -124,13 +139,26 @@ struct Scene {
   std::vector<Quad> quads;
   std::vector<Sphere> spheres;
   std::vector<Target> targets;
-  float scale = 1.0f;  // largest coordinate magnitude
+  // Where the rendering space's origin is, in the scene file's coordinates:
+  // every position here is the file's minus `origin`, taken in double and
+  // rounded once to float. The loader puts it at the camera where the camera
+  // is far from the file's origin beside what it sees (kCameraCentredRatio),
+  // else at 0. Positions shown to a person (the probe's point, a
+  // screenshot's camera) are turned back with file_point.
+  std::array<double, 3> origin{};
+  float scale = 1.0f;  // largest coordinate magnitude (in the rendering space)
   QuadBatch quad_batch;  // derived from quads by prepare()
 
   // Builds derived data (camera basis, quad batch). Call after editing the
   // scene; intersect() falls back to a scalar loop while the batch is stale.
   void prepare();
 };
+
+// A rendering-space position in the scene file's coordinates (+ origin, in double).
+inline std::array<double, 3> file_point(const Scene& scene, const Vec3& p) {
+  return {static_cast<double>(p.x) + scene.origin[0], static_cast<double>(p.y) + scene.origin[1],
+          static_cast<double>(p.z) + scene.origin[2]};
+}
 
 struct Hit {
   float t;

@@ -10,6 +10,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -26,6 +29,18 @@ namespace {
 // A scene is a few kilobytes; this bounds what a wrong path (a disk image,
 // /dev/zero) can make the loader read into memory.
 constexpr std::size_t kMaxSceneBytes = std::size_t{64} << 20;
+
+// A position in double: the scene file's numbers before they are rounded to
+// the rendering space's floats.
+struct D3 {
+  double x, y, z;
+};
+D3 operator+(const D3& a, const D3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+D3 operator-(const D3& a, const D3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+D3 d3(const Vec3& v) { return {v.x, v.y, v.z}; }
+Vec3 to_float(const D3& a) { return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)}; }
+double max_abs(const D3& a) { return std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z))); }
+double norm(const D3& a) { return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
 
 // A JSON value with the path that leads to it, for error messages.
 class Node {
@@ -86,10 +101,13 @@ class Node {
     if (!v_.is_string()) fail("expected a string, found " + std::string(v_.type_name()));
     return v_.get<std::string>();
   }
-  Vec3 vec3() const {
+  // The numbers as written (in double), for positions that the rendering
+  // space may move (Scene::origin) before they are rounded to float.
+  D3 dvec3() const {
     if (!v_.is_array() || v_.size() != 3) fail("expected an array of 3 numbers");
-    return {element(0).real(), element(1).real(), element(2).real()};
+    return {element(0).number(), element(1).number(), element(2).number()};
   }
+  Vec3 vec3() const { return to_float(dvec3()); }
 
  private:
   const json& v_;
@@ -103,7 +121,35 @@ Vec3 nonnegative_colour(const Node& n) {
   return c;
 }
 
-void parse_camera(const Node& node, Scene& scene) {
+// The objects as the file places them, before the rendering space is chosen:
+// each quad's corner (a box's faces too) and each sphere's centre in double,
+// and as the book computes them in float, which a scene whose rendering space
+// stays at the file's origin keeps (the same bits as ever).
+struct Placement {
+  struct QuadRow {
+    D3 corner;
+    Vec3 corner_float;
+    Vec3 u, v;              // as the book computes them (a box's from its float corners)
+    Vec3 u_exact, v_exact;  // from the file's numbers in double, rounded once (a quad's: u and v)
+    std::uint32_t material;
+  };
+  struct SphereRow {
+    D3 center;
+    float radius;
+    std::uint32_t material;
+  };
+  struct BoxRow {
+    std::size_t first_face;  // its six faces in `quads`, from here
+    float smallest_side;
+    std::size_t object;  // its index in the file's objects, for the refusal's message
+  };
+  D3 lookfrom{}, lookat{};
+  std::vector<QuadRow> quads;
+  std::vector<SphereRow> spheres;
+  std::vector<BoxRow> boxes;
+};
+
+void parse_camera(const Node& node, Scene& scene, Placement& placement) {
   node.expect_object();
   node.allow_only({"width", "height", "vfov", "lookfrom", "lookat", "vup", "max_depth", "background"});
   Camera& cam = scene.camera;
@@ -113,16 +159,12 @@ void parse_camera(const Node& node, Scene& scene) {
   const Node vfov = node.require("vfov");
   cam.vfov_degrees = vfov.real();
   if (!(cam.vfov_degrees > 0.0f && cam.vfov_degrees < 180.0f)) vfov.fail("must be between 0 and 180 degrees (exclusive)");
-  cam.lookfrom = node.require("lookfrom").vec3();
-  cam.lookat = node.require("lookat").vec3();
+  // Placed in the rendering space with the objects (place_in_rendering_space).
+  placement.lookfrom = node.require("lookfrom").dvec3();
+  placement.lookat = node.require("lookat").dvec3();
   cam.vup = node.has("vup") ? node.child("vup").vec3() : Vec3(0.0f, 1.0f, 0.0f);
-  const Vec3 view = cam.lookat - cam.lookfrom;
-  if (view == Vec3(0.0f)) node.fail("lookfrom and lookat are the same point");
-  // Both as unit vectors whatever their length (unit_direction): a camera far
-  // from its target squares its distance past float's range, and is not
-  // therefore looking along vup.
-  const Vec3 side = cross(unit_direction(cam.vup), unit_direction(view));
-  if (!(length(side) > 1e-6f)) node.fail("vup is zero or parallel to the viewing direction");
+  const D3 view = placement.lookat - placement.lookfrom;
+  if (view.x == 0.0 && view.y == 0.0 && view.z == 0.0) node.fail("lookfrom and lookat are the same point");
   scene.max_depth = node.has("max_depth") ? node.child("max_depth").integer(1, 10000) : 50;
   scene.background = node.has("background") ? nonnegative_colour(node.child("background")) : Vec3(0.0f);
 }
@@ -185,7 +227,8 @@ void check_quad(const Node& node, const Vec3& u, const Vec3& v) {
   if (const std::string problem = quad_problem(u, v); !problem.empty()) node.fail(problem);
 }
 
-void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& materials, Scene& scene) {
+void parse_object(const Node& node, std::size_t index, const std::map<std::string, std::uint32_t>& materials,
+                  Scene& scene, Placement& placement) {
   node.expect_object();
   const Node type_node = node.require("type");
   const std::string type = type_node.string();
@@ -199,26 +242,44 @@ void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& 
 
   if (type == "quad") {
     node.allow_only({"type", "q", "u", "v", "material", "importance"});
-    const Vec3 q = node.require("q").vec3(), u = node.require("u").vec3(), v = node.require("v").vec3();
+    const D3 q = node.require("q").dvec3();
+    const Vec3 u = node.require("u").vec3(), v = node.require("v").vec3();
     check_quad(node, u, v);
-    if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(scene.quads.size())});
-    scene.quads.push_back(make_quad(q, u, v, mat));
+    if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(placement.quads.size())});
+    placement.quads.push_back({q, to_float(q), u, v, u, v, mat});
   } else if (type == "sphere") {
     node.allow_only({"type", "center", "radius", "material", "importance"});
-    const Vec3 c = node.require("center").vec3();
+    const D3 c = node.require("center").dvec3();
     const Node r = node.require("radius");
     const float radius = r.real();
     if (!(radius > 0.0f)) r.fail("must be > 0");
-    if (importance) scene.targets.push_back({Target::Kind::Sphere, static_cast<std::uint32_t>(scene.spheres.size())});
-    scene.spheres.push_back({c, radius, mat});
+    if (importance) scene.targets.push_back({Target::Kind::Sphere, static_cast<std::uint32_t>(placement.spheres.size())});
+    placement.spheres.push_back({c, radius, mat});
   } else if (type == "box") {
     node.allow_only({"type", "min", "max", "rotate_y", "translate", "material", "importance"});
-    const Vec3 lo = node.require("min").vec3(), hi = node.require("max").vec3();
-    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) node.fail("box 'max' must exceed 'min' on every axis");
-    const float angle = node.has("rotate_y") ? node.child("rotate_y").real() * (kPi / 180.0f) : 0.0f;
-    const Vec3 offset = node.has("translate") ? node.child("translate").vec3() : Vec3(0.0f);
+    const D3 lo_d = node.require("min").dvec3(), hi_d = node.require("max").dvec3();
+    const Vec3 lo = to_float(lo_d), hi = to_float(hi_d);
+    if (!(hi_d.x > lo_d.x && hi_d.y > lo_d.y && hi_d.z > lo_d.z))
+      node.fail("box 'max' must exceed 'min' on every axis");
+    const double degrees = node.has("rotate_y") ? node.child("rotate_y").number() : 0.0;
+    const float angle = static_cast<float>(degrees) * (kPi / 180.0f);
+    const D3 offset_d = node.has("translate") ? node.child("translate").dvec3() : D3{0.0, 0.0, 0.0};
+    const Vec3 offset = to_float(offset_d);
     const float c = std::cos(angle), s = std::sin(angle);
+    // The corners again in double, for a rendering space away from the file's origin.
+    const double cd = std::cos(degrees * (3.14159265358979323846 / 180.0)),
+                 sd = std::sin(degrees * (3.14159265358979323846 / 180.0));
+    const auto rotated = [&](const D3& p) { return D3{cd * p.x + sd * p.z, p.y, -sd * p.x + cd * p.z} + offset_d; };
+    const D3 corners_d[6] = {{lo_d.x, lo_d.y, hi_d.z}, {hi_d.x, lo_d.y, hi_d.z}, {hi_d.x, lo_d.y, lo_d.z},
+                             {lo_d.x, lo_d.y, lo_d.z}, {lo_d.x, hi_d.y, hi_d.z}, {lo_d.x, lo_d.y, lo_d.z}};
     const Vec3 dx(hi.x - lo.x, 0, 0), dy(0, hi.y - lo.y, 0), dz(0, 0, hi.z - lo.z);
+    // The sides in double: float's corners far from the origin round them to
+    // its steps there (a box 1e-3 across at 1e3 had sides 6% off).
+    const D3 side = hi_d - lo_d;
+    const Vec3 ex(static_cast<float>(side.x), 0, 0), ey(0, static_cast<float>(side.y), 0),
+        ez(0, 0, static_cast<float>(side.z));
+    const Vec3 edges[6][2] = {{ex, ey}, {-ez, ey}, {-ex, ey}, {ez, ey}, {ex, -ez}, {ex, ez}};
+    placement.boxes.push_back({placement.quads.size(), std::min(ex.x, std::min(ey.y, ez.z)), index});
     // Six faces, each with an outward front normal (u x v).
     const Vec3 faces[6][3] = {
         {{lo.x, lo.y, hi.z}, dx, dy},   // +z
@@ -228,14 +289,97 @@ void parse_object(const Node& node, const std::map<std::string, std::uint32_t>& 
         {{lo.x, hi.y, hi.z}, dx, -dz},  // +y
         {{lo.x, lo.y, lo.z}, dx, dz},   // -y
     };
-    for (const auto& f : faces) {
-      check_quad(node, f[1], f[2]);
-      if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(scene.quads.size())});
-      scene.quads.push_back(make_quad(rotate_y(f[0], c, s) + offset, rotate_y(f[1], c, s), rotate_y(f[2], c, s), mat));
+    for (int i = 0; i < 6; ++i) {
+      const auto& f = faces[i];
+      check_quad(node, edges[i][0], edges[i][1]);
+      if (importance) scene.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(placement.quads.size())});
+      placement.quads.push_back({rotated(corners_d[i]), rotate_y(f[0], c, s) + offset, rotate_y(f[1], c, s),
+                                 rotate_y(f[2], c, s), rotate_y(edges[i][0], c, s), rotate_y(edges[i][1], c, s), mat});
     }
   } else {
     type_node.fail("unknown object type '" + type + "' (quad, box, sphere)");
   }
+}
+
+// The distance from p to the nearest object: a quad's bounding box (a box's
+// faces' too), a sphere's surface. Only a scale for choosing the rendering
+// space, not a distance anything is rendered with.
+double nearest_object(const Placement& placement, const D3& p) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Placement::QuadRow& q : placement.quads) {
+    const D3 u = d3(q.u_exact), v = d3(q.v_exact);
+    const D3 corners[4] = {q.corner, q.corner + u, q.corner + v, q.corner + u + v};
+    D3 lo = corners[0], hi = corners[0];
+    for (const D3& c : corners) {
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+    }
+    const D3 outside = {std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+                        std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+    nearest = std::min(nearest, norm(outside));
+  }
+  for (const Placement::SphereRow& sp : placement.spheres)
+    nearest = std::min(nearest, std::fabs(norm(sp.center - p) - static_cast<double>(sp.radius)));
+  return nearest;
+}
+
+// A float's step at magnitude m (the spacing of floats in [2^k, 2^(k+1))).
+double float_step(double m) {
+  if (!(m >= static_cast<double>(std::numeric_limits<float>::min()))) return 0.0;
+  int exponent = 0;
+  std::frexp(m, &exponent);  // m = f 2^exponent, f in [0.5, 1)
+  return std::ldexp(1.0, exponent - 24);
+}
+
+// Chooses the rendering space (Scene::origin), rounds every position into it,
+// and refuses what float cannot hold there: a box too small for its
+// coordinates, a camera whose lookat rounds onto lookfrom.
+void place_in_rendering_space(const Node& root, const Placement& placement, Scene& scene) {
+  const D3 from = placement.lookfrom;
+  const double sees = std::min(nearest_object(placement, from), norm(placement.lookat - from));
+  const bool camera_centred = max_abs(from) > kCameraCentredRatio * sees;
+  const D3 origin = camera_centred ? from : D3{0.0, 0.0, 0.0};
+  scene.origin = {origin.x, origin.y, origin.z};
+  const auto place = [&](const D3& p, const Vec3& as_book) { return camera_centred ? to_float(p - origin) : as_book; };
+
+  // A box first: where float cannot place its faces they may not even be quads.
+  for (const Placement::BoxRow& box : placement.boxes) {
+    float reach = 0.0f;
+    for (std::size_t i = box.first_face; i < box.first_face + 6; ++i) {
+      const Placement::QuadRow& f = placement.quads[i];
+      const Vec3 q = place(f.corner, f.corner_float);
+      reach = std::max({reach, max_abs_component(q), max_abs_component(q + f.u_exact + f.v_exact)});
+    }
+    const double step = float_step(reach);
+    if (static_cast<double>(box.smallest_side) < kSmallestBoxSteps * step) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "the box's smallest side (%.3g) spans fewer than %.0f steps of single precision where it is "
+                    "(its corners reach %.3g from the rendering space's origin, %s, where a step is %.3g): "
+                    "place it nearer the camera or the origin, or make it larger",
+                    static_cast<double>(box.smallest_side), kSmallestBoxSteps, static_cast<double>(reach),
+                    camera_centred ? "the camera" : "the scene's origin", step);
+      root.child("objects").element(box.object).fail(text);
+    }
+  }
+  for (const Placement::QuadRow& q : placement.quads) {
+    const Vec3 u = camera_centred ? q.u_exact : q.u, v = camera_centred ? q.v_exact : q.v;
+    scene.quads.push_back(make_quad(place(q.corner, q.corner_float), u, v, q.material));
+  }
+  for (const Placement::SphereRow& sp : placement.spheres)
+    scene.spheres.push_back({place(sp.center, to_float(sp.center)), sp.radius, sp.material});
+
+  Camera& cam = scene.camera;
+  cam.lookfrom = place(placement.lookfrom, to_float(placement.lookfrom));
+  cam.lookat = place(placement.lookat, to_float(placement.lookat));
+  const Node camera = root.child("camera");
+  const Vec3 view = cam.lookat - cam.lookfrom;
+  if (view == Vec3(0.0f)) camera.fail("lookfrom and lookat are the same point in single precision");
+  // Both as unit vectors whatever their length (unit_direction): a camera far
+  // from its target squares its distance past float's range, and is not
+  // therefore looking along vup.
+  const Vec3 side = cross(unit_direction(cam.vup), unit_direction(view));
+  if (!(length(side) > 1e-6f)) camera.fail("vup is zero or parallel to the viewing direction");
 }
 
 std::string line_and_column(const std::string& text, std::size_t byte) {
@@ -358,7 +502,8 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : origin;
   if (root.has("description")) (void)root.child("description").string();
-  parse_camera(root.require("camera"), scene);
+  Placement placement;
+  parse_camera(root.require("camera"), scene, placement);
 
   const Node mats = root.require("materials");
   mats.expect_object();
@@ -372,7 +517,9 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
   const Node objects = root.require("objects");
   objects.expect_array();
   if (objects.value().empty()) objects.fail("the scene has no objects");
-  for (std::size_t i = 0; i < objects.value().size(); ++i) parse_object(objects.element(i), by_name, scene);
+  for (std::size_t i = 0; i < objects.value().size(); ++i)
+    parse_object(objects.element(i), i, by_name, scene, placement);
+  place_in_rendering_space(root, placement, scene);
 
   scene.prepare();
   scene.content_hash = content_hash(doc);
