@@ -14,7 +14,8 @@
 // image at scene scales from 1e-3 to 1e6, quad lights down to 1e-5 of the scene
 // and sphere lights down to 1e-9 of it (rays aimed at a sphere that float
 // cannot aim at reach it: the aimed-ray rule), including shading points
-// nearly in the light's plane.
+// nearly in the light's plane, and a light beside one 1e9 times as bright
+// that faces away (the light choice by what a point receives).
 #include "renderer/integrator/integrator.h"
 #include "renderer/scene/scene_loader.h"
 
@@ -63,6 +64,11 @@ struct AnalyticCase {
   double sliver = 1.0;  // a quad's second edge is light_size * sliver
   Ground ground = Ground::Floor;
   double ground_radius = 0.0;  // Ground::Sphere: centre at (0, -radius, 0)
+  // A second, one-sided quad light this many times as bright, off to the side
+  // and facing up, away from everything (0: none): its light leaves the scene,
+  // so the image is the first light's alone, but chosen by power it would get
+  // all but 1 / (1 + starving) of the light samples.
+  double starving = 0.0;
 };
 
 constexpr double kAlbedo = 0.5;
@@ -85,8 +91,12 @@ std::string scene_json(const AnalyticCase& c) {
     << R"("lookfrom": [0, )" << 0.25 * s << ", " << -0.6 * s << R"(], "lookat": [0, 0, 0]},)"
     << R"("materials": {"floor": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]},)"
     << R"("lamp": {"type": "diffuse_light", "emit": [)" << emission(c) << ", " << emission(c) << ", "
-    << emission(c) << "]}},"
-    << R"("objects": [)";
+    << emission(c) << "]}";
+  if (c.starving > 0.0) {
+    const double e = emission(c) * c.starving;
+    o << R"(, "bright": {"type": "diffuse_light", "emit": [)" << e << ", " << e << ", " << e << "]}";
+  }
+  o << R"(}, "objects": [)";
   if (c.ground == Ground::Floor) {
     // Normal +y: u x v = (0, 0, 8s) x (8s, 0, 0).
     o << R"({"type": "quad", "q": [)" << -4 * s << ", 0, " << -4 * s << R"(], "u": [0, 0, )" << 8 * s
@@ -94,6 +104,11 @@ std::string scene_json(const AnalyticCase& c) {
   } else {
     o << R"({"type": "sphere", "center": [0, )" << -c.ground_radius << R"(, 0], "radius": )" << c.ground_radius
       << R"(, "material": "floor"},)";
+  }
+  if (c.starving > 0.0) {
+    // Facing up: u x v = (0, 0, a) x (a, 0, 0) = (0, a^2, 0); out of the camera's view.
+    o << R"({"type": "quad", "q": [)" << 3 * s << ", " << h << ", " << lz - a / 2 << R"(], "u": [0, 0, )" << a
+      << R"(], "v": [)" << a << R"(, 0, 0], "material": "bright"},)";
   }
   if (c.shape == LightShape::Quad) {
     // Facing down: u x v = (a, 0, 0) x (0, 0, a) = (0, -a^2, 0).
@@ -361,6 +376,21 @@ std::vector<Param> cases() {
     c.light_z = 0.3;
     c.name = radius == 1e3 ? "ground_sphere_1e3" : "ground_sphere_1e5";
     for (const auto& s : light_strategies) out.push_back({c, s, light_spp(s)});
+  }
+  // A light starved by another's power: a lamp 1e9 times as bright as the
+  // scene's light, facing away from everything. Chosen by power alone, the
+  // scene's light got 1e-9 of the light samples and light-sa rendered black;
+  // chosen by what the point receives (the floor is behind the bright lamp),
+  // and with the defensive floor, it gets 95% of them.
+  for (const double scale : {1.0, 1e6}) {
+    AnalyticCase c;
+    c.scale = scale;
+    c.light_size = 0.1;
+    c.light_z = 0.3;
+    c.starving = 1e9;
+    c.name = scale == 1.0 ? "starved" : "s1e6_starved";
+    // The book's `light` still chooses the two lamps alike: half its samples find nothing.
+    for (const auto& s : light_strategies) out.push_back({c, s, 4 * light_spp(s)});
   }
   // Every case again through the one-path tracer.
   const std::size_t n = out.size();

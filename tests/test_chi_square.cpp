@@ -537,8 +537,10 @@ TEST(ChiSquareDistribution, PoolsSmallCellsAndCountsImpossibleSamples) {
 namespace pdflab {
 namespace {
 
-// light-sa and nee-mis choose a target in proportion to its power; light
-// (the book's) uniformly. Counted directly: which quad does each sample reach?
+// light-sa and nee-mis choose a target in proportion to its power, with a
+// tenth of the choices uniform (TargetSet::by_point; the point receives from
+// both lamps); light (the book's) uniformly. Counted directly: which quad does
+// each sample reach?
 TEST(TargetChoice, ProportionalToPowerForLightSaUniformForLight) {
   const std::unique_ptr<Scene> scene = make_scene(Targets::TwoPowers);
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light-sa"), *scene);
@@ -548,7 +550,11 @@ TEST(TargetChoice, ProportionalToPowerForLightSaUniformForLight) {
   EXPECT_NEAR(plan.emitters.quads[0].probability, 40.0 / 41.0, 1e-6);
 
   const Vec3 origin(0, 0, 0);
-  for (const auto& [set, expected] : {std::pair{&plan.power_targets, 40.0 / 41.0}, std::pair{&plan.book_targets, 0.5}}) {
+  const double by_power = kLightChoiceFloor / 2.0 + (1.0 - kLightChoiceFloor) * 40.0 / 41.0;
+  EXPECT_NEAR(plan.power_targets.probabilities_at(origin)[0], by_power, 1e-6);
+  EXPECT_NEAR(plan.emitters.probabilities_at(origin)[0], by_power, 1e-6);
+  EXPECT_EQ(plan.book_targets.probabilities_at(origin)[0], 0.5f);
+  for (const auto& [set, expected] : {std::pair{&plan.power_targets, by_power}, std::pair{&plan.book_targets, 0.5}}) {
     Rng rng(77, 1);
     const int n = 200000;
     int bright = 0, dim = 0;

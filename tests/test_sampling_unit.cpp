@@ -586,6 +586,59 @@ TEST(SamplingPlan, PowerRatiosOfABillionAreRealisedInEitherOrder) {
   }
 }
 
+// Light choice by what the point receives (TargetSet::by_point): a dim lamp
+// facing down and one 1e9 times as bright facing up, side by side.
+TEST(SamplingPlan, LightChoiceFollowsWhatThePointReceives) {
+  Scene scene;
+  scene.name = "starved";
+  Material bright, dim;
+  bright.type = dim.type = MaterialType::DiffuseLight;
+  bright.emit = Vec3(1e9f);
+  dim.emit = Vec3(1.0f);
+  scene.materials = {dim, bright};
+  scene.material_names = {"dim", "bright"};
+  scene.quads.push_back(make_quad(Vec3(-3.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));  // u x v = -y
+  scene.quads.push_back(make_quad(Vec3(2.0f, 5, -0.5f), Vec3(0, 0, 1), Vec3(1, 0, 0), 1));   // u x v = +y
+  scene.targets = {{Target::Kind::Quad, 0}, {Target::Kind::Quad, 1}};
+  for (const char* strategy : {"light-sa", "nee-mis"}) {
+    SCOPED_TRACE(strategy);
+    const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), scene);
+    const TargetSet& set = std::string(strategy) == "nee-mis" ? plan.emitters : plan.power_targets;
+    ASSERT_TRUE(set.by_point);
+    const float floor_share = kLightChoiceFloor / 2.0f;
+    const auto multiple_of_2_24 = [](float p) { return std::ldexp(p, 24) == std::floor(std::ldexp(p, 24)); };
+    // Below them a point receives from the dim lamp only, above them from the
+    // bright one only, in their plane from neither (then the choice is uniform).
+    struct At {
+      Vec3 point;
+      float dim;  // the dim lamp's probability there
+    };
+    for (const At& at : {At{Vec3(0.0f, 0.0f, 0.0f), 1.0f - floor_share}, At{Vec3(0.0f, 9.0f, 0.0f), floor_share},
+                         At{Vec3(0.0f, 5.0f, 0.0f), 0.5f}}) {
+      const std::vector<float> p = set.probabilities_at(at.point);
+      ASSERT_EQ(p.size(), 2u);
+      EXPECT_NEAR(p[0], at.dim, 0x1.0p-23f) << at.point.y;
+      EXPECT_EQ(static_cast<double>(p[0]) + p[1], 1.0) << at.point.y;
+      EXPECT_TRUE(multiple_of_2_24(p[0]) && multiple_of_2_24(p[1])) << at.point.y;
+      EXPECT_EQ(set.receives(at.point, 0), at.dim > 0.5f);
+      // The numbers that choose each lamp from there are where first_choice_of
+      // says; the sample's density is the set's.
+      for (int j = 0; j < 2; ++j) {
+        const std::uint32_t first = set.first_choice_of(at.point, j);
+        for (const std::uint32_t u : {first, first + 255u}) {
+          const DirectionSample ds = set.sample(at.point, u, 0.5f, 0.5f);
+          if (ds.none) continue;
+          EXPECT_EQ(ds.aimed_quad, j) << at.point.y << " u " << u;
+          EXPECT_NEAR(ds.pdf, set.pdf(at.point, ds.direction, ds.aimed_quad, ds.aimed_distance), 1e-5f * ds.pdf);
+        }
+        if (j > 0) {
+          EXPECT_EQ(set.sample(at.point, first - 1u, 0.5f, 0.5f).aimed_quad, j - 1);
+        }
+      }
+    }
+  }
+}
+
 TEST(SamplingPlan, LightWithoutTargetsIsAnInputError) {
   Scene scene = one_target_scene(false);
   scene.targets.clear();

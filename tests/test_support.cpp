@@ -305,10 +305,9 @@ TEST(Support, EveryTargetTechniqueReachesItsTargetsOutlines) {
                            : t == Technique::LightSolidAngle ? plan.power_targets
                                                              : plan.specular_objects;
     ASSERT_FALSE(set.empty()) << info.name;
-    const std::vector<std::uint32_t>& threshold = set.choice.thresholds();
     const int nq = static_cast<int>(set.quads.size());
     for (int j = 0; j < set.size(); ++j) {
-      const std::uint32_t u_target = j == 0 ? 0u : threshold[static_cast<std::size_t>(j - 1)];
+      const std::uint32_t u_target = set.first_choice_of(point, j);
       std::vector<Vec3> drawn;
       for (const float u1 : {0.0f, kLargestUniform})
         for (const float u2 : {0.0f, 0.25f, 0.5f, 0.75f, kLargestUniform}) {

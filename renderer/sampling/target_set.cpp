@@ -21,6 +21,31 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   int i = 0;
   for (auto& q : quads) q.probability = choice.pmf(i++);
   for (auto& sp : spheres) sp.probability = choice.pmf(i++);
+  by_point = solid_angle && size() >= 2;
+}
+
+bool TargetSet::receives(const Vec3& origin, int j) const { return leaf::receives_light(*this, j, origin); }
+
+std::vector<float> TargetSet::probabilities_at(const Vec3& origin) const {
+  std::vector<float> out;
+  out.reserve(static_cast<std::size_t>(size()));
+  if (!by_point) {
+    for (const QuadEntry& e : quads) out.push_back(e.probability);
+    for (const SphereEntry& e : spheres) out.push_back(e.probability);
+    return out;
+  }
+  leaf::TargetChoice c = leaf::begin_choice(*this, origin);
+  for (int j = 0; j < size(); ++j) out.push_back(leaf::next_choice(*this, c, origin));
+  return out;
+}
+
+std::uint32_t TargetSet::first_choice_of(const Vec3& origin, int j) const {
+  if (j <= 0) return 0u;
+  if (!by_point) return choice.thresholds()[static_cast<std::size_t>(j - 1)];
+  double below = 0.0;  // C_{j-1}: the probabilities are multiples of 2^-24, so the sum is exact
+  const std::vector<float> p = probabilities_at(origin);
+  for (int i = 0; i < j; ++i) below += p[static_cast<std::size_t>(i)];
+  return static_cast<std::uint32_t>(below * 0x1.0p32);
 }
 
 float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const void* skip, int aimed_quad,

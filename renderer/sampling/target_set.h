@@ -16,7 +16,7 @@ namespace pdflab {
 struct TargetSet {
   struct QuadEntry {
     const Quad* quad;
-    float probability;
+    float probability;  // its share of the choice (by_point: of the choice before the point's reweighting)
     std::int32_t index;  // in Scene::quads (DirectionSample::aimed_quad)
     RectangleAxes axes;  // for solid-angle sampling (leaf::spherical_rectangle)
   };
@@ -33,6 +33,16 @@ struct TargetSet {
   // entry's `probability` is exactly its realised share.
   DiscreteDistribution choice;
   bool solid_angle = false;  // quads by spherical rectangle instead of by area
+  // Light choice by what the point receives (set_probabilities, on a set by
+  // solid angle of two or more targets): from a point behind a one-sided
+  // emitter that emitter's share goes to the others, and a fraction
+  // kLightChoiceFloor of the choices is uniform, a defensive floor: no target
+  // is chosen with less than kLightChoiceFloor / size() (a dim light beside a
+  // 1e9 times brighter one keeps 5% of the choices, not 1e-9). The choice's
+  // probabilities at a point are quantised to multiples of 2^-24, which is how
+  // a 32-bit number's top 24 bits choose (leaf::TargetChoice): each target's
+  // probability is exactly its realised share.
+  bool by_point = false;
 
   bool empty() const { return quads.empty() && spheres.empty(); }
   int size() const { return static_cast<int>(quads.size() + spheres.size()); }
@@ -50,18 +60,33 @@ struct TargetSet {
   // reach that quad at distance aimed_t (DirectionSample::aimed_quad), so its
   // term holds even for a sliver float's intersection test would miss.
   float pdf(const Vec3& origin, const Vec3& direction, int aimed_quad = -1, float aimed_t = 0.0f) const;
+  // The probability of choosing each target (quads, then spheres) from `origin`:
+  // `probability` itself unless by_point.
+  std::vector<float> probabilities_at(const Vec3& origin) const;
+  // The smallest 32-bit u_choice that chooses target j from `origin` (its
+  // probability there must be positive).
+  std::uint32_t first_choice_of(const Vec3& origin, int j) const;
+  // Whether `origin` receives light from target j: false only behind a
+  // one-sided emitter (in front: its plane's side that u x v points to).
+  bool receives(const Vec3& origin, int j) const;
 
  private:
   float pdf_without(const Vec3& origin, const Vec3& direction, const void* skip, int aimed_quad = -1,
                     float aimed_t = 0.0f) const;
 };
 
+// TargetSet::by_point's defensive floor: the fraction of a point's light
+// choices that is uniform over the targets.
+inline constexpr float kLightChoiceFloor = 0.1f;
+
 // `light`'s set: the scene's importance targets, chosen uniformly.
 TargetSet book_target_set(const Scene& scene);
 // `light-sa`'s: the importance targets by solid angle, chosen in proportion to
-// their power (a target that emits nothing gets the mean emitter's share).
+// their power (a target that emits nothing gets the mean emitter's share) and
+// to what the point receives (TargetSet::by_point).
 TargetSet power_target_set(const Scene& scene);
-// nee-mis's: every emitter of the scene by solid angle, chosen by power, except
+// nee-mis's: every emitter of the scene by solid angle, chosen by power and by
+// what the point receives (TargetSet::by_point), quads by solid angle except
 // where a rectangle looks flat: from a point whose distances to the light's
 // points differ by at most kEmitterFlatDistanceRatio it is sampled by area
 // (RectangleAxes::flat_distance_ratio), whose density is then within the cube
