@@ -78,6 +78,38 @@ TEST(Probe, ChiSquareCheckFailsWhenThePdfDisagreesWithTheSampler) {
   EXPECT_LT(c.result.p_value, 1e-6);
 }
 
+// The probe lists the light choice at the clicked point: in the starved box
+// (a beacon 1.6e9 times the ceiling light's power beside it, facing up) the
+// floor is behind the beacon, which keeps only the defensive floor's share;
+// by power alone it would take all but 6e-10 of the choices.
+TEST(Probe, ListsTheLightChoiceAtThePoint) {
+  Scene s = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/starved_light.json");
+  s.camera.width = s.camera.height = 100;
+  s.prepare();
+  const ProbePoint floor = first_diffuse_hit(s, 50, 97);
+  ASSERT_TRUE(floor.found);
+  for (const char* strategy : {"nee-mis", "mix:cosine=0.5,light-sa=0.5"}) {
+    SCOPED_TRACE(strategy);
+    const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), s);
+    const ProbeLightChoice choice = probe_light_choice(s, plan, floor);
+    ASSERT_EQ(choice.rows.size(), 2u);
+    EXPECT_EQ(choice.rows[0].label, "light (quad)");
+    EXPECT_EQ(choice.rows[1].label, "beacon (quad)");
+    EXPECT_TRUE(choice.rows[0].receives);
+    EXPECT_FALSE(choice.rows[1].receives);
+    EXPECT_LT(choice.rows[0].share, 1e-9f);
+    EXPECT_NEAR(choice.rows[0].probability, 1.0f - kLightChoiceFloor / 2.0f, 1e-6f);
+    EXPECT_NEAR(choice.rows[1].probability, kLightChoiceFloor / 2.0f, 1e-6f);
+  }
+  // The book's light chooses uniformly, wherever the point is.
+  const SamplingPlan book = SamplingPlan::make(Strategy::parse("mix:cosine=0.5,light=0.5"), s);
+  const ProbeLightChoice uniform = probe_light_choice(s, book, floor);
+  EXPECT_EQ(uniform.set, "light targets");
+  ASSERT_EQ(uniform.rows.size(), 2u);
+  EXPECT_EQ(uniform.rows[1].probability, 0.5f);
+  EXPECT_TRUE(probe_light_choice(s, SamplingPlan::make(Strategy::parse("cosine"), s), floor).rows.empty());
+}
+
 TEST(Probe, PdfMapShowsTheLightAboveTheFloor) {
   const Scene s = book();
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light"), s);

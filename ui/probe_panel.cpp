@@ -184,6 +184,31 @@ void chi_square_section(ProbeState& s, double now) {
   plot.legend({{"observed", IM_COL32(90, 170, 255, 200)}, {"expected", IM_COL32(255, 190, 60, 255)}});
 }
 
+// Each light's probability of being chosen at the point, beside its share by power.
+void light_choice_section(const ProbeState& s) {
+  const ProbeLightChoice& c = s.light_choice;
+  if (c.rows.size() < 2) return;
+  ImGui::Separator();
+  ImGui::Text("Light choice here (%s)", c.set.c_str());
+  if (!ImGui::BeginTable("light choice", 3, ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_RowBg)) return;
+  ImGui::TableSetupColumn("light");
+  ImGui::TableSetupColumn("by power");
+  ImGui::TableSetupColumn("at this point");
+  ImGui::TableHeadersRow();
+  for (const ProbeLightChoice::Row& r : c.rows) {
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted(r.label.c_str());
+    ImGui::TableNextColumn();
+    ImGui::TextColored(kDim, "%.3g", r.share);
+    ImGui::TableNextColumn();
+    if (r.receives) ImGui::Text("%.3g", r.probability);
+    else ImGui::TextColored(kAmber, "%.3g  (behind it)", r.probability);
+  }
+  ImGui::EndTable();
+  ImGui::TextColored(kDim, "by what the point receives, a tenth of the choices uniform");
+}
+
 }  // namespace
 
 DiscPoint project_to_disc(float u, float v) {
@@ -210,15 +235,15 @@ std::optional<PixelHit> pixel_at(float px, float py, float rect_x, float rect_y,
 }
 
 int light_target_of(const SamplingPlan& plan, const Vec3& origin, const Vec3& direction) {
-  // Each target alone as a set of one: its pdf is positive exactly where it is seen.
+  // Each target alone as a set of one: its pdf is positive exactly where it is
+  // seen. Of several in line, the nearest (what the ray reaches first).
   const TargetSet& all = plan.book_targets;
   int best = -1;
-  float best_pdf = 0.0f;
-  const auto consider = [&](TargetSet one, int index) {
+  float best_distance = kInf;
+  const auto consider = [&](TargetSet one, int index, float distance) {
     one.set_probabilities({1.0});
-    const float p = one.pdf(origin, direction);
-    if (p > best_pdf) {
-      best_pdf = p;
+    if (one.pdf(origin, direction) > 0.0f && distance < best_distance) {
+      best_distance = distance;
       best = index;
     }
   };
@@ -226,12 +251,13 @@ int light_target_of(const SamplingPlan& plan, const Vec3& origin, const Vec3& di
   for (const auto& q : all.quads) {
     TargetSet one;
     one.quads.push_back(q);
-    consider(std::move(one), index++);
+    const float t = quad_hit_distance(*q.quad, origin, direction);
+    consider(std::move(one), index++, t >= 0.0f ? t : 1e30f);
   }
   for (const auto& sp : all.spheres) {
     TargetSet one;
     one.spheres.push_back(sp);
-    consider(std::move(one), index++);
+    consider(std::move(one), index++, length(sp.sphere->center - origin) - sp.sphere->radius);
   }
   return best;
 }
@@ -269,6 +295,7 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   s.scene = std::move(scene);
   s.point = first_diffuse_hit(*s.scene, x, y, seed);
   s.samples.clear();
+  s.light_choice = {};
   s.sample_target.clear();
   s.target_labels.clear();
   std::fill(s.technique_counts.begin(), s.technique_counts.end(), 0);
@@ -289,6 +316,7 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
       const std::string name = material < sc.material_names.size() ? sc.material_names[material] : "target";
       return name + " (" + kind + ")";
     };
+    s.light_choice = probe_light_choice(sc, *s.plan, s.point);
     for (const auto& q : s.plan->book_targets.quads) s.target_labels.push_back(label(q.quad->material, "quad"));
     for (const auto& sp : s.plan->book_targets.spheres) s.target_labels.push_back(label(sp.sphere->material, "sphere"));
   }
@@ -362,6 +390,8 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   ImGui::Dummy(ImVec2(1.0f, line * 0.5f));
   legend(s);
   ImGui::EndGroup();
+
+  light_choice_section(s);
 
   ImGui::Separator();
   // The strategy's map with its colour bar, and beside it the two lobes it mixes.

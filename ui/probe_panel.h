@@ -64,6 +64,7 @@ struct ProbeState {
   std::vector<int> sample_target;
   std::vector<std::string> target_labels;
   ProbeMap strategy_map, cosine_map, light_map;
+  ProbeLightChoice light_choice;  // each light's probability at the point
 
   // Kept alive for the chi-square job, which reads both.
   std::shared_ptr<const Scene> scene;

@@ -129,6 +129,35 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
   return out;
 }
 
+ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan, const ProbePoint& at) {
+  ProbeLightChoice out;
+  const TargetSet* set = nullptr;
+  if (plan.nee_mis) {
+    set = &plan.emitters, out.set = "nee-mis emitters";
+  } else if (plan.weight[static_cast<int>(Technique::LightSolidAngle)] > 0.0f) {
+    set = &plan.power_targets, out.set = "light-sa targets";
+  } else if (plan.weight[static_cast<int>(Technique::Light)] > 0.0f) {
+    set = &plan.book_targets, out.set = "light targets";
+  }
+  if (!set || !at.found || set->empty()) return out;
+  const std::vector<float> p = set->probabilities_at(at.point);
+  const auto label = [&](std::uint32_t material, const char* kind) {
+    const std::string name = material < scene.material_names.size() ? scene.material_names[material] : "target";
+    return name + " (" + kind + ")";
+  };
+  int j = 0;
+  for (const TargetSet::QuadEntry& e : set->quads) {
+    out.rows.push_back({label(e.quad->material, "quad"), e.probability, p[static_cast<std::size_t>(j)],
+                        set->receives(at.point, j)});
+    ++j;
+  }
+  for (const TargetSet::SphereEntry& e : set->spheres) {
+    out.rows.push_back({label(e.sphere->material, "sphere"), e.probability, p[static_cast<std::size_t>(j)], true});
+    ++j;
+  }
+  return out;
+}
+
 ProbeChiSquare probe_chi_square(const SamplingPlan& plan, const ProbePoint& at, int samples, std::uint64_t seed,
                                 int z_cells, int phi_cells, double alpha) {
   ProbeChiSquare out;

@@ -8,6 +8,7 @@
 #include "renderer/scene/scene.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace pdflab {
@@ -38,6 +39,22 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
 
 // Map coordinates (0..1) of a direction in pdf_map's layout.
 void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);
+
+// How the strategy's light technique chooses a light at the probe point
+// (TargetSet::by_point): one row per target of the set it draws from
+// (nee-mis: its emitters; else light-sa's targets, else light's), quads first.
+struct ProbeLightChoice {
+  std::string set;  // "nee-mis emitters", "light-sa targets" or "light targets"
+  struct Row {
+    std::string label;  // the material's name and the shape, e.g. "light (quad)"
+    float share = 0.0f;        // its share of the choice by power (the set's own)
+    float probability = 0.0f;  // the probability of choosing it at the point
+    bool receives = true;      // false: the point is behind this one-sided light
+  };
+  std::vector<Row> rows;
+};
+// Empty rows where the strategy draws no light or the probe found no point.
+ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan, const ProbePoint& at);
 
 // Chi-square test of the plan's samplers against plan.pdf at the probe point,
 // by the test suite's harness (chi_square.h): samples binned in `phi_cells` x
