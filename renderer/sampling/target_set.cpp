@@ -22,6 +22,17 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   for (auto& q : quads) q.probability = choice.pmf(i++);
   for (auto& sp : spheres) sp.probability = choice.pmf(i++);
   by_point = solid_angle && size() >= 2;
+  everywhere.clear();
+  one_sided.clear();
+  if (!by_point) return;
+  for (int j = 0; j < static_cast<int>(quads.size()); ++j)
+    if (quads[static_cast<std::size_t>(j)].axes.one_sided) one_sided.push_back(j);
+  // The walk of leaf::each_choice for a point that receives from all, in the
+  // same float operations, so that its probabilities are the same numbers.
+  float received = 0.0f;
+  for (int j = 0; j < size(); ++j) received = received + leaf::target_share(*this, j);
+  leaf::TargetChoice c = leaf::begin_choice(*this, received);
+  for (int j = 0; j < size(); ++j) everywhere.push_back(leaf::next_choice(*this, c, j, true));
 }
 
 bool TargetSet::receives(const Vec3& origin, int j) const { return leaf::receives_light(*this, j, origin); }
@@ -34,8 +45,7 @@ std::vector<float> TargetSet::probabilities_at(const Vec3& origin) const {
     for (const SphereEntry& e : spheres) out.push_back(e.probability);
     return out;
   }
-  leaf::TargetChoice c = leaf::begin_choice(*this, origin);
-  for (int j = 0; j < size(); ++j) out.push_back(leaf::next_choice(*this, c, origin));
+  leaf::each_choice(*this, origin, true, [&](int, float p) { out.push_back(p); });
   return out;
 }
 

@@ -43,6 +43,11 @@ struct TargetSet {
   // a 32-bit number's top 24 bits choose (leaf::TargetChoice): each target's
   // probability is exactly its realised share.
   bool by_point = false;
+  // by_point: each target's probability from a point that receives from every
+  // target (the choice's usual case, fixed), and the one-sided quads (indices
+  // in `quads`), whose sides decide whether a point does.
+  std::vector<float> everywhere;
+  std::vector<int> one_sided;
 
   bool empty() const { return quads.empty() && spheres.empty(); }
   int size() const { return static_cast<int>(quads.size() + spheres.size()); }
