@@ -381,7 +381,7 @@ std::vector<Param> cases() {
   // scene's light, facing away from everything. Chosen by power alone, the
   // scene's light got 1e-9 of the light samples and light-sa rendered black;
   // chosen by what the point receives (the floor is behind the bright lamp),
-  // and with the defensive floor, it gets 95% of them.
+  // and with the defensive floor, it gets 99% of them.
   for (const double scale : {1.0, 1e6}) {
     AnalyticCase c;
     c.scale = scale;

@@ -537,8 +537,8 @@ TEST(ChiSquareDistribution, PoolsSmallCellsAndCountsImpossibleSamples) {
 namespace pdflab {
 namespace {
 
-// light-sa and nee-mis choose a target in proportion to its power, with a
-// tenth of the choices uniform (TargetSet::by_point; the point receives from
+// light-sa and nee-mis choose a target in proportion to its power, with 2%
+// of the choices uniform (TargetSet::by_point; the point receives from
 // both lamps); light (the book's) uniformly. Counted directly: which quad does
 // each sample reach?
 TEST(TargetChoice, ProportionalToPowerForLightSaUniformForLight) {

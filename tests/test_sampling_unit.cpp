@@ -608,19 +608,20 @@ TEST(SamplingPlan, LightChoiceFollowsWhatThePointReceives) {
     const float floor_share = kLightChoiceFloor / 2.0f;
     const auto multiple_of_2_24 = [](float p) { return std::ldexp(p, 24) == std::floor(std::ldexp(p, 24)); };
     // Below them a point receives from the dim lamp only, above them from the
-    // bright one only, in their plane from neither (then the choice is uniform).
+    // bright one only, in their plane from neither (then each keeps its share
+    // by power, and the dim lamp has only the floor's).
     struct At {
       Vec3 point;
       float dim;  // the dim lamp's probability there
     };
     for (const At& at : {At{Vec3(0.0f, 0.0f, 0.0f), 1.0f - floor_share}, At{Vec3(0.0f, 9.0f, 0.0f), floor_share},
-                         At{Vec3(0.0f, 5.0f, 0.0f), 0.5f}}) {
+                         At{Vec3(0.0f, 5.0f, 0.0f), floor_share}}) {
       const std::vector<float> p = set.probabilities_at(at.point);
       ASSERT_EQ(p.size(), 2u);
       EXPECT_NEAR(p[0], at.dim, 0x1.0p-23f) << at.point.y;
       EXPECT_EQ(static_cast<double>(p[0]) + p[1], 1.0) << at.point.y;
       EXPECT_TRUE(multiple_of_2_24(p[0]) && multiple_of_2_24(p[1])) << at.point.y;
-      EXPECT_EQ(set.receives(at.point, 0), at.dim > 0.5f);
+      EXPECT_EQ(set.receives(at.point, 0), at.point.y < 5.0f);
       // The numbers that choose each lamp from there are where first_choice_of
       // says; the sample's density is the set's.
       for (int j = 0; j < 2; ++j) {

@@ -206,7 +206,7 @@ void light_choice_section(const ProbeState& s) {
     else ImGui::TextColored(kAmber, "%.3g  (behind it)", r.probability);
   }
   ImGui::EndTable();
-  ImGui::TextColored(kDim, "by what the point receives, a tenth of the choices uniform");
+  ImGui::TextColored(kDim, "by what the point receives, %g%% of the choices uniform", 100.0 * kLightChoiceFloor);
 }
 
 }  // namespace

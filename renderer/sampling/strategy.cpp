@@ -177,8 +177,9 @@ std::string strategy_help() {
       "  nee-mis: a light sample and a continuation at each diffuse vertex, weighed by MIS (power heuristic,\n"
       "    :balance the balance heuristic); the continuation is drawn by MIXTURE (default cosine), e.g.\n"
       "    nee-mis+mix:cosine=0.5,light=0.5 keeps aiming at the book's glass sphere; its light sample takes an\n"
-      "    emitter by power, uniformly in solid angle, or by area from where the light's farthest point is at\n"
-      "    most twice as far as its nearest (there the two densities are within a factor 8, area is cheaper)\n"
+      "    emitter by power (none behind a one-sided light, 2% of the choices uniform), uniformly in solid\n"
+      "    angle, or by area from where the light's farthest point is at most twice as far as its nearest\n"
+      "    (there the two densities are within a factor 8, area is cheaper)\n"
       "  +rr[:D]: Russian roulette from D path segments on (default " + std::to_string(kDefaultRouletteDepth) +
       "): a path goes on with probability\n"
       "    min(1, largest throughput component), its throughput divided by it (unbiased; off by default)\n"

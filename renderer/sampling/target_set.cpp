@@ -3,6 +3,7 @@
 #include "renderer/sampling/mixture.h"
 #include "renderer/sampling/techniques.h"
 
+#include <algorithm>
 #include <numbers>
 
 namespace pdflab {
@@ -23,16 +24,26 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   for (auto& sp : spheres) sp.probability = choice.pmf(i++);
   by_point = solid_angle && size() >= 2;
   everywhere.clear();
+  everywhere_threshold.clear();
   one_sided.clear();
   if (!by_point) return;
-  for (int j = 0; j < static_cast<int>(quads.size()); ++j)
-    if (quads[static_cast<std::size_t>(j)].axes.one_sided) one_sided.push_back(j);
+  int lights = 0;
+  for (int j = 0; j < size(); ++j) lights += leaf::target_emits(*this, j) ? 1 : 0;
+  if (lights >= 2)
+    for (int j = 0; j < static_cast<int>(quads.size()); ++j)
+      if (quads[static_cast<std::size_t>(j)].axes.one_sided) one_sided.push_back(j);
   // The walk of leaf::each_choice for a point that receives from all, in the
   // same float operations, so that its probabilities are the same numbers.
-  float received = 0.0f;
-  for (int j = 0; j < size(); ++j) received = received + leaf::target_share(*this, j);
-  leaf::TargetChoice c = leaf::begin_choice(*this, received);
-  for (int j = 0; j < size(); ++j) everywhere.push_back(leaf::next_choice(*this, c, j, true));
+  emitter_share = 0.0f;
+  for (int j = 0; j < size(); ++j)
+    if (leaf::target_emits(*this, j)) emitter_share = emitter_share + leaf::target_share(*this, j);
+  leaf::TargetChoice c = leaf::begin_choice(*this, emitter_share);
+  double below = 0.0;  // C_j: sums of multiples of 2^-24, exact
+  for (int j = 0; j < size(); ++j) {
+    everywhere.push_back(leaf::next_choice(*this, c, j, true));
+    below += everywhere.back();
+    if (j + 1 < size()) everywhere_threshold.push_back(static_cast<std::uint32_t>(std::min(below * 0x1.0p32, 4294967295.0)));
+  }
 }
 
 bool TargetSet::receives(const Vec3& origin, int j) const { return leaf::receives_light(*this, j, origin); }
@@ -45,7 +56,8 @@ std::vector<float> TargetSet::probabilities_at(const Vec3& origin) const {
     for (const SphereEntry& e : spheres) out.push_back(e.probability);
     return out;
   }
-  leaf::each_choice(*this, origin, true, [&](int, float p) { out.push_back(p); });
+  leaf::ChoiceWalk walk = leaf::begin_walk(*this, origin, true);
+  for (int j = 0; j < size(); ++j) out.push_back(walk.next());
   return out;
 }
 
@@ -123,6 +135,8 @@ std::vector<double> collect_targets(const Scene& scene, TargetSet& set, Pick pic
     sphere_power.push_back(emitter_power(scene.materials[sp.material], area));
   }
   quad_power.insert(quad_power.end(), sphere_power.begin(), sphere_power.end());
+  set.emits.clear();
+  for (const double p : quad_power) set.emits.push_back(p > 0.0 ? 1 : 0);
   return quad_power;
 }
 

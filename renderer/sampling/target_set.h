@@ -35,7 +35,7 @@ struct TargetSet {
   bool solid_angle = false;  // quads by spherical rectangle instead of by area
   // Light choice by what the point receives (set_probabilities, on a set by
   // solid angle of two or more targets): from a point behind a one-sided
-  // emitter that emitter's share goes to the others, and a fraction
+  // emitter that emitter's share goes to the lights in front, and a fraction
   // kLightChoiceFloor of the choices is uniform, a defensive floor: no target
   // is chosen with less than kLightChoiceFloor / size() (a dim light beside a
   // 1e9 times brighter one keeps 5% of the choices, not 1e-9). The choice's
@@ -47,7 +47,14 @@ struct TargetSet {
   // target (the choice's usual case, fixed), and the one-sided quads (indices
   // in `quads`), whose sides decide whether a point does.
   std::vector<float> everywhere;
+  std::vector<std::uint32_t> everywhere_threshold;  // C_j 2^32 for all but the last target
+  // Empty where the choice cannot depend on the point (fewer than two lights:
+  // a share has nowhere to go).
   std::vector<int> one_sided;
+  // Whether each target emits (light-sa's glass sphere does not: it keeps its
+  // share wherever the point is; empty: all do), and the emitters' total share.
+  std::vector<unsigned char> emits;
+  float emitter_share = 1.0f;
 
   bool empty() const { return quads.empty() && spheres.empty(); }
   int size() const { return static_cast<int>(quads.size() + spheres.size()); }
@@ -82,7 +89,7 @@ struct TargetSet {
 
 // TargetSet::by_point's defensive floor: the fraction of a point's light
 // choices that is uniform over the targets.
-inline constexpr float kLightChoiceFloor = 0.1f;
+inline constexpr float kLightChoiceFloor = 0.02f;
 
 // `light`'s set: the scene's importance targets, chosen uniformly.
 TargetSet book_target_set(const Scene& scene);
