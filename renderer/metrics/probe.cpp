@@ -183,7 +183,8 @@ std::string delta_lobe_note(const Scene& scene, const ProbePoint& at) {
                                                                            : "";
   if (m.type == MaterialType::Dielectric)
     return "The clicked surface is " + name + " (glass, ior " + short_number(m.ior) +
-           "): a delta lobe, the mirror direction or the refracted one, chosen by the Fresnel reflectance; "
+           "): a delta lobe, the mirror direction or the refracted one, chosen by the Fresnel reflectance (" +
+           (m.exact_fresnel ? "exact" : "Schlick's") + "); "
            "no density a strategy could draw or mix. The probe follows it to the first non-specular surface.";
   if (m.fuzz > 0.0f)
     return "The clicked surface is " + name + " (metal, fuzz " + short_number(m.fuzz) +
