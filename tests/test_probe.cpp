@@ -1,5 +1,6 @@
 // The pixel probe: it finds the first diffuse surface behind a pixel, its
-// directions come from the techniques in proportion to their weights, and its
+// directions come from the techniques in proportion to their weights, the
+// material's own (bsdf) lobe it shows is the technique's density, and its
 // in-app chi-square check passes for every strategy at several pixels of the
 // book's scene (and fails when the pdf it is handed is wrong).
 #include "renderer/metrics/probe.h"
@@ -7,7 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <string>
 
 namespace pdflab {
 namespace {
@@ -126,6 +131,112 @@ TEST(Probe, PdfMapShowsTheLightAboveTheFloor) {
   // Below the floor (the lower half of the map) the light pdf is zero.
   for (int r = h / 2; r < h; ++r)
     for (int c = 0; c < w; ++c) ASSERT_EQ(map[static_cast<std::size_t>(r) * w + c], 0.0f) << r << "," << c;
+}
+
+// Veach's scene at its own size: four microfacet plates and a lambertian backdrop.
+Scene veach() {
+  Scene s = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/veach_mis.json");
+  s.prepare();
+  return s;
+}
+
+// The first probe point down the image's middle column whose material is `name`.
+ProbePoint find_point(const Scene& s, const std::string& name) {
+  for (int y = 0; y < s.camera.height; ++y) {
+    const ProbePoint at = first_diffuse_hit(s, s.camera.width / 2, y);
+    if (at.found && s.material_names[at.material] == name) return at;
+  }
+  return {};
+}
+
+// The integral of a map over the sphere: every cell spans 4 pi / (w h).
+double map_integral(const std::vector<float>& map, int w, int h) {
+  double sum = 0.0;
+  for (float v : map) sum += v;
+  return sum * 4.0 * 3.14159265358979323846 / (static_cast<double>(w) * h);
+}
+
+// The material's own lobe beside the light lobe: at a lambertian point it is
+// the cosine lobe, at a microfacet point GGX's visible normals reflected; it
+// is the bsdf technique's density (the probe's strategy map for `bsdf` is the
+// same map), it integrates to one over the sphere, and the directions the
+// probe draws with `bsdf` carry that very density.
+TEST(Probe, BsdfLobeIsTheTechniquesDensityAndIntegratesToOne) {
+  const Scene s = veach();
+  const SamplingPlan bsdf = SamplingPlan::make(Strategy::parse("bsdf"), s);
+  const int w = 512, h = 256;
+  for (const char* name : {"backdrop", "plate1", "plate2", "plate3", "plate4"}) {
+    const ProbePoint at = find_point(s, name);
+    ASSERT_TRUE(at.found) << name;
+    const Material& m = s.materials[at.material];
+    EXPECT_EQ(at.surface.glossy, m.type == MaterialType::Microfacet) << name;
+    if (at.surface.glossy) {
+      EXPECT_EQ(at.surface.alpha, m.alpha) << name;
+    }
+    EXPECT_GT(dot(at.surface.outgoing, at.normal), 0.0f) << name;
+
+    // Cell averages over 8 x 8 points: the narrowest lobe (alpha 0.005,
+    // about 0.01 rad) spans several points.
+    const std::vector<float> lobe = bsdf_pdf_map(s, at, w, h, 8);
+    const double integral = map_integral(lobe, w, h);
+    std::printf("[probe] %s (alpha %g): the bsdf lobe integrates to %.5f, its largest cell %.4g\n", name,
+                at.surface.glossy ? at.surface.alpha : 0.0f, integral, *std::max_element(lobe.begin(), lobe.end()));
+    EXPECT_NEAR(integral, 1.0, 5e-3) << name;
+
+    // At cell centres the map is the technique's pdf, and the strategy map of
+    // `bsdf` is the same map (it sees the surface too).
+    const std::vector<float> centres = bsdf_pdf_map(s, at, 64, 32);
+    const std::vector<float> strategy = pdf_map(bsdf, at, 64, 32);
+    EXPECT_EQ(centres, strategy) << name;
+    const std::vector<ProbeSample> drawn = probe_directions(bsdf, at, 2000, 5);
+    ASSERT_EQ(drawn.size(), 2000u);
+    int below = 0;
+    for (const ProbeSample& d : drawn) {
+      ASSERT_EQ(d.technique, static_cast<int>(Technique::Bsdf));
+      const float p = bsdf_pdf(s, at, d.direction);
+      EXPECT_NEAR(d.pdf, p, 1e-3f * p) << name;
+      below += dot(d.direction, at.normal) <= 0.0f;
+      if (!at.surface.glossy) {
+        EXPECT_NEAR(p, dot(d.direction, at.normal) / 3.14159265f, 1e-5f) << name;
+      }
+    }
+    if (!at.surface.glossy) {
+      EXPECT_EQ(below, 0);
+    }
+    // The lobe's mass where the probe's draws fall: the 10% of cells the lobe
+    // weighs most hold the draws in the same share as the lobe's mass there.
+    const int cw = 64, ch = 32;
+    const std::vector<float> coarse = bsdf_pdf_map(s, at, cw, ch, 16);
+    std::vector<float> sorted = coarse;
+    std::sort(sorted.begin(), sorted.end(), std::greater<>());
+    const float cut = sorted[sorted.size() / 10];
+    double mass = 0.0;
+    for (float v : coarse)
+      if (v > cut) mass += v * 4.0 * 3.14159265358979323846 / (cw * ch);
+    int inside = 0;
+    for (const ProbeSample& d : drawn) {
+      float u, v;
+      direction_to_map(at, d.direction, u, v);
+      const int col = std::min(cw - 1, static_cast<int>(u * cw)), row = std::min(ch - 1, static_cast<int>(v * ch));
+      inside += coarse[static_cast<std::size_t>(row) * cw + col] > cut;
+    }
+    const double share = inside / 2000.0;
+    EXPECT_NEAR(share, mass, 5.0 * std::sqrt(mass * (1.0 - mass) / 2000.0) + 1e-3) << name;
+  }
+}
+
+TEST(Probe, TheBsdfLobeSaysWhatItIs) {
+  const Scene s = veach();
+  EXPECT_NE(bsdf_lobe_name(s, find_point(s, "backdrop")).find("cosine lobe"), std::string::npos);
+  EXPECT_NE(bsdf_lobe_name(s, find_point(s, "plate4")).find("GGX visible normals, alpha 0.005"), std::string::npos);
+  EXPECT_EQ(delta_lobe_note(s, find_point(s, "plate4")), "");
+  // Through the book's glass sphere: the clicked surface is a delta lobe.
+  const Scene b = book();
+  const ProbePoint through_glass = first_diffuse_hit(b, 70, 85);
+  ASSERT_TRUE(through_glass.found);
+  const std::string note = delta_lobe_note(b, through_glass);
+  EXPECT_NE(note.find("glass"), std::string::npos) << note;
+  EXPECT_NE(note.find("delta lobe"), std::string::npos) << note;
 }
 
 }  // namespace

@@ -21,12 +21,31 @@ constexpr int kMapWidth = 96, kMapHeight = 48;
 constexpr int kLobeWidth = 64, kLobeHeight = 32;
 constexpr int kChiSamples = 200000;
 
+// Each map cell shows the pdf averaged over the cell (kSupersample^2 points):
+// a small light or a sharp glossy lobe narrower than a cell still shows.
+constexpr int kSupersample = 8;
+
 ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h) {
   ProbeMap map;
   map.title = title;
   try {
     const SamplingPlan plan = SamplingPlan::make(strategy, scene);
-    map.values = pdf_map(plan, at, w, h);
+    map.values = pdf_map(plan, at, w, h, kSupersample);
+    map.width = w;
+    map.height = h;
+    for (float v : map.values)
+      if (std::isfinite(v)) map.max_value = std::max(map.max_value, v);
+  } catch (const InputError& e) {
+    map.error = e.what();
+  }
+  return map;
+}
+
+ProbeMap make_bsdf_map(const Scene& scene, const ProbePoint& at, int w, int h) {
+  ProbeMap map;
+  map.title = "bsdf alone (the material's lobe)";
+  try {
+    map.values = bsdf_pdf_map(scene, at, w, h, kSupersample);
     map.width = w;
     map.height = h;
     for (float v : map.values)
@@ -38,8 +57,10 @@ ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strateg
 }
 
 // The map as coloured cells. Log scale: four decades below the maximum, so a
-// mixture's broad cosine part shows beside its sharp light part.
-void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale) {
+// mixture's broad cosine part shows beside its sharp light part. `scale_top`:
+// the value at the top of the colour scale (0: the map's own maximum), so
+// maps drawn side by side can share one scale.
+void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale, double scale_top = 0.0) {
   ImGui::TextUnformatted(map.title.c_str());
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
   ImGui::Dummy(size);
@@ -51,7 +72,7 @@ void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale) {
     return;
   }
   const float cw = size.x / static_cast<float>(map.width), ch = size.y / static_cast<float>(map.height);
-  const double top = map.max_value > 0.0f ? map.max_value : 1.0;
+  const double top = scale_top > 0.0 ? scale_top : map.max_value > 0.0f ? map.max_value : 1.0;
   for (int r = 0; r < map.height; ++r)
     for (int c = 0; c < map.width; ++c) {
       const double v = map.values[static_cast<std::size_t>(r) * map.width + c];
@@ -322,10 +343,11 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   }
   s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
                             s.point, kMapWidth, kMapHeight);
-  s.cosine_map = make_map("cosine alone", *s.scene, Strategy::single(Technique::Cosine), s.point, kLobeWidth,
-                          kLobeHeight);
-  s.light_map = make_map("light alone", *s.scene, Strategy::single(Technique::Light), s.point, kLobeWidth,
-                         kLobeHeight);
+  s.light_map = make_map("light alone (the light lobe)", *s.scene, Strategy::single(Technique::Light), s.point,
+                         kLobeWidth, kLobeHeight);
+  s.bsdf_map = make_bsdf_map(*s.scene, s.point, kLobeWidth, kLobeHeight);
+  s.bsdf_lobe = bsdf_lobe_name(*s.scene, s.point);
+  s.delta_note = delta_lobe_note(*s.scene, s.point);
 }
 
 void start_probe_chi_square(ProbeState& s, double now) {
@@ -394,14 +416,12 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   light_choice_section(s);
 
   ImGui::Separator();
-  // The strategy's map with its colour bar, and beside it the two lobes it mixes.
+  // The strategy's map with its colour bar.
   const float bar_w = ImGui::CalcTextSize("1e+04").x + 22.0f;
-  const float lobe_w = std::max(120.0f, avail * 0.3f);
-  const float map_w = std::max(160.0f, avail - bar_w - lobe_w - 2.0f * spacing);
-  const float map_h = map_w * 0.5f;
+  const float map_w = std::max(160.0f, avail - bar_w - spacing);
+  const float map_h = std::min(map_w * 0.5f, 150.0f);
   ImGui::BeginGroup();
-  draw_map(s.strategy_map, ImVec2(map_w, map_h), s.log_scale);
-  ImGui::Checkbox("log colour scale (4 decades)", &s.log_scale);
+  draw_map(s.strategy_map, ImVec2(map_h * 2.0f, map_h), s.log_scale);
   ImGui::EndGroup();
   ImGui::SameLine();
   ImGui::BeginGroup();
@@ -410,11 +430,40 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   ImGui::EndGroup();
   ImGui::SameLine();
   ImGui::BeginGroup();
-  draw_map(s.cosine_map, ImVec2(lobe_w, lobe_w * 0.5f), s.log_scale);
-  draw_map(s.light_map, ImVec2(lobe_w, lobe_w * 0.5f), s.log_scale);
+  ImGui::Checkbox("log colour scale\n(4 decades)", &s.log_scale);
   ImGui::EndGroup();
-  ImGui::TextColored(kDim, "phi across, cos(theta) from +1 (top) to -1; line: the horizon. Maxima: %.3g, %.3g, %.3g",
-                     s.strategy_map.max_value, s.cosine_map.max_value, s.light_map.max_value);
+  // The two lobes a strategy can mix at this point, side by side on one
+  // colour scale and in the same projection: where the light is, and where
+  // the material sends light.
+  ImGui::TextColored(kDim, "The light lobe and the material's own lobe here, on one colour scale:");
+  const double lobes_top = std::max(s.light_map.max_value, s.bsdf_map.max_value);
+  const float lobe_w = std::max(120.0f, (avail - bar_w - 2.0f * spacing) * 0.5f);
+  const float lobe_h = std::min(lobe_w * 0.5f, 130.0f);
+  ImGui::BeginGroup();
+  draw_map(s.light_map, ImVec2(lobe_h * 2.0f, lobe_h), s.log_scale, lobes_top);
+  ImGui::EndGroup();
+  ImGui::SameLine();
+  ImGui::BeginGroup();
+  draw_map(s.bsdf_map, ImVec2(lobe_h * 2.0f, lobe_h), s.log_scale, lobes_top);
+  ImGui::EndGroup();
+  ImGui::SameLine();
+  ImGui::BeginGroup();
+  draw::colour_bar(ImVec2(bar_w, lobe_h + line + 4.0f), s.log_scale ? lobes_top * 1e-4 : 0.0, lobes_top, s.log_scale,
+                   "pdf");
+  ImGui::EndGroup();
+  ImGui::TextWrapped("bsdf here: %s", s.bsdf_lobe.c_str());
+  ImGui::PushStyleColor(ImGuiCol_Text, kDim);
+  ImGui::TextWrapped("phi across, cos(theta) from +1 (top) to -1; line: the horizon; each cell the pdf averaged over "
+                     "it. Maxima: strategy %.3g, light %.3g, bsdf %.3g",
+                     s.strategy_map.max_value, s.light_map.max_value, s.bsdf_map.max_value);
+  ImGui::PopStyleColor();
+  if (!s.delta_note.empty()) ImGui::TextWrapped("%s", s.delta_note.c_str());
+  if (s.point.surface.glossy && s.plan && !s.plan->nee_mis && s.plan->weight[static_cast<int>(Technique::Bsdf)] > 0.0f) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kDim);
+    ImGui::TextWrapped("The chi-square check below draws bsdf at a lambertian lobe; the VNDF sampler's own check is "
+                       "test_chi_square's ChiSquareVndf.");
+    ImGui::PopStyleColor();
+  }
 
   ImGui::Separator();
   chi_square_section(s, now);

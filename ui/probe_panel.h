@@ -1,8 +1,8 @@
 #pragma once
 // The pixel probe panel: what a strategy does at the first diffuse surface a
 // clicked pixel sees. Directions drawn there on projected hemisphere discs, the
-// pdf as a lat-long map, the cosine and light lobes alone, and a chi-square
-// check run off the UI thread.
+// pdf as a lat-long map, the light lobe and the material's own (bsdf) lobe
+// alone on one colour scale, and a chi-square check run off the UI thread.
 #include "renderer/metrics/probe.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/scene/scene.h"
@@ -63,7 +63,13 @@ struct ProbeState {
   // sample) and a label per target, e.g. "light (quad)", "glass (sphere)".
   std::vector<int> sample_target;
   std::vector<std::string> target_labels;
-  ProbeMap strategy_map, cosine_map, light_map;
+  // The strategy's pdf; beside it, on one colour scale, the light lobe (the
+  // `light` technique alone) and the material's own lobe (the `bsdf`
+  // technique alone: cosine at a lambertian point, GGX's visible normals at a
+  // microfacet one).
+  ProbeMap strategy_map, light_map, bsdf_map;
+  std::string bsdf_lobe;   // what the material's own lobe is here, in words
+  std::string delta_note;  // the clicked surface is glass or metal: its delta lobe, in words
   ProbeLightChoice light_choice;  // each light's probability at the point
 
   // Kept alive for the chi-square job, which reads both.

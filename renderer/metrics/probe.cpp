@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 namespace pdflab {
@@ -27,9 +28,13 @@ ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t see
       at.point = diffuse_origin(hit, n);  // where its rays leave from
       at.normal = n;
       at.material = hit.material;
+      at.surface.glossy = m.type == MaterialType::Microfacet;
+      at.surface.alpha = m.alpha;
+      at.surface.outgoing = normalize(-ray.direction);
       return at;
     }
     if (m.type == MaterialType::DiffuseLight) return at;
+    if (depth == 0) at.first_material = hit.material;
     Vec3 dir;
     if (m.type == MaterialType::Metal) {
       dir = ray.direction - n * (2.0f * dot(ray.direction, n));
@@ -67,12 +72,12 @@ std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbeP
       }
       // ...and one from its continuation's mixture (the cosine lobe for plain nee-mis).
       int technique = 0;
-      const DirectionSample cs = plan.sample(at.point, at.normal, rng, &technique);
+      const DirectionSample cs = plan.sample(at.point, at.normal, rng, &technique, -1, &at.surface);
       out.push_back({cs.direction, cs.pdf, cs.none ? -1 : technique});
       continue;
     }
     int technique = 0;
-    const DirectionSample ds = plan.sample(at.point, at.normal, rng, &technique);
+    const DirectionSample ds = plan.sample(at.point, at.normal, rng, &technique, -1, &at.surface);
     out.push_back({ds.direction, ds.pdf, ds.none ? -1 : technique});
   }
   return out;
@@ -98,10 +103,44 @@ struct MapFrame {
 float shown_pdf(const SamplingPlan& plan, const ProbePoint& at, const Vec3& d) {
   if (plan.nee_mis) {
     const float light = plan.emitters.empty() ? 0.0f : plan.emitters.pdf(at.point, d);
-    const float continuation = plan.pdf(at.point, at.normal, d);
+    const float continuation = plan.pdf(at.surface, at.point, at.normal, d);
     return plan.emitters.empty() ? continuation : 0.5f * (light + continuation);
   }
-  return plan.pdf(at.point, at.normal, d);
+  return plan.pdf(at.surface, at.point, at.normal, d);
+}
+
+// The lat-long map of any density of a direction, in pdf_map's layout: each
+// cell the mean of the density at k x k points spread evenly over it in
+// (cos theta, phi), where equal areas are equal solid angles (k = 1: the
+// cell's centre).
+template <typename Density>
+std::vector<float> map_of(const ProbePoint& at, int width, int height, int k, const Density& density) {
+  std::vector<float> out(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0f);
+  if (!at.found) return out;
+  k = std::max(1, k);
+  const MapFrame f(at.normal);
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      double sum = 0.0;
+      for (int a = 0; a < k; ++a) {
+        const float fa = (static_cast<float>(a) + 0.5f) / static_cast<float>(k);
+        const float z = 1.0f - 2.0f * (static_cast<float>(row) + fa) / static_cast<float>(height);
+        for (int b = 0; b < k; ++b) {
+          const float fb = (static_cast<float>(b) + 0.5f) / static_cast<float>(k);
+          const float phi = 2.0f * kPi * (static_cast<float>(col) + fb) / static_cast<float>(width);
+          sum += static_cast<double>(density(f.direction(z, phi)));
+        }
+      }
+      out[static_cast<std::size_t>(row) * width + col] = static_cast<float>(sum / (k * k));
+    }
+  }
+  return out;
+}
+
+std::string short_number(float x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(x));
+  return text;
 }
 
 }  // namespace
@@ -115,18 +154,45 @@ void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, flo
   v = (1.0f - z) * 0.5f;
 }
 
-std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int width, int height) {
-  std::vector<float> out(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0f);
-  if (!at.found) return out;
-  const MapFrame f(at.normal);
-  for (int row = 0; row < height; ++row) {
-    const float z = 1.0f - 2.0f * (static_cast<float>(row) + 0.5f) / static_cast<float>(height);
-    for (int col = 0; col < width; ++col) {
-      const float phi = 2.0f * kPi * (static_cast<float>(col) + 0.5f) / static_cast<float>(width);
-      out[static_cast<std::size_t>(row) * width + col] = shown_pdf(plan, at, f.direction(z, phi));
-    }
-  }
-  return out;
+std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int width, int height, int supersample) {
+  return map_of(at, width, height, supersample, [&](const Vec3& d) { return shown_pdf(plan, at, d); });
+}
+
+std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int width, int height, int supersample) {
+  const SamplingPlan plan = SamplingPlan::make(Strategy::single(Technique::Bsdf), scene);
+  return map_of(at, width, height, supersample, [&](const Vec3& d) { return plan.pdf(at.surface, at.point, at.normal, d); });
+}
+
+float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction) {
+  const SamplingPlan plan = SamplingPlan::make(Strategy::single(Technique::Bsdf), scene);
+  return plan.pdf(at.surface, at.point, at.normal, direction);
+}
+
+std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at) {
+  if (!at.found) return "no surface";
+  const std::string name = at.material < scene.material_names.size() ? scene.material_names[at.material] : "";
+  if (at.surface.glossy)
+    return "GGX visible normals, alpha " + short_number(at.surface.alpha) + " (" + name + ": microfacet)";
+  return "cosine lobe (" + name + ": lambertian)";
+}
+
+std::string delta_lobe_note(const Scene& scene, const ProbePoint& at) {
+  if (at.specular_bounces == 0 || at.first_material >= scene.materials.size()) return {};
+  const Material& m = scene.materials[at.first_material];
+  const std::string name = at.first_material < scene.material_names.size() ? scene.material_names[at.first_material]
+                                                                           : "";
+  if (m.type == MaterialType::Dielectric)
+    return "The clicked surface is " + name + " (glass, ior " + short_number(m.ior) +
+           "): a delta lobe, the mirror direction or the refracted one, chosen by the Fresnel reflectance (" +
+           (m.exact_fresnel ? "exact" : "Schlick's") + "); "
+           "no density a strategy could draw or mix. The probe follows it to the first non-specular surface.";
+  if (m.fuzz > 0.0f)
+    return "The clicked surface is " + name + " (metal, fuzz " + short_number(m.fuzz) +
+           "): the mirror direction perturbed by fuzz, followed outside any pdf. The probe follows the mirror "
+           "direction to the first non-specular surface.";
+  return "The clicked surface is " + name +
+         " (metal): a delta lobe, the mirror direction alone; no density a strategy could draw or mix. "
+         "The probe follows it to the first non-specular surface.";
 }
 
 ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan, const ProbePoint& at) {

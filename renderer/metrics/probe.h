@@ -17,7 +17,13 @@ struct ProbePoint {
   bool found = false;  // false: the pixel's ray left the scene or hit a light first
   Vec3 point{0.0f}, normal{0.0f};  // normal faces the arriving ray
   std::uint32_t material = 0;
+  // The surface there for the `bsdf` technique: lambertian, or a microfacet
+  // conductor of roughness alpha seen from where the ray came (outgoing).
+  SurfaceLobe surface;
   int specular_bounces = 0;  // mirror/glass bounces before the diffuse hit
+  // The first surface the pixel's ray meets, when it is glass or metal (its
+  // lobe is a delta: one direction, no density); valid if specular_bounces > 0.
+  std::uint32_t first_material = 0;
 };
 
 // Follows the ray through pixel centre (x, y) past metal and glass (glass
@@ -34,8 +40,29 @@ std::vector<ProbeSample> probe_directions(const SamplingPlan& plan, const ProbeP
 
 // The pdf over the whole sphere of directions in a lat-long map around the
 // normal: column = azimuth phi in [0, 2 pi), row = cos(theta) from +1 (top,
-// the normal) to -1. `width` x `height` values, row-major.
-std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int width, int height);
+// the normal) to -1. `width` x `height` values, row-major. Rows are equal
+// steps of cos(theta), so every cell spans the same solid angle,
+// 4 pi / (width * height). `supersample` k: each value is the mean of the pdf
+// at k x k points spread over its cell (the cell's mass over its solid angle,
+// so a lobe narrower than a cell still shows); 1: the pdf at the cell's centre.
+std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int width, int height,
+                           int supersample = 1);
+
+// The material's own lobe at the probe point, as the `bsdf` technique draws
+// it: the cosine lobe at a lambertian surface, GGX's visible normals
+// reflected at a microfacet one. The same layout as pdf_map, so the two are
+// compared cell by cell; each value is the technique's pdf (per steradian).
+std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int width, int height,
+                                int supersample = 1);
+// The bsdf technique's pdf at the probe point for one direction.
+float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction);
+// In words, what that lobe is at the probe point ("cosine lobe (lambertian)",
+// "GGX visible normals, alpha 0.07 (microfacet)").
+std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at);
+// In words, the delta lobe of the first surface when it is glass or metal
+// ("glass (ior 1.5): a delta lobe ..."); empty when the first surface is the
+// probe point itself.
+std::string delta_lobe_note(const Scene& scene, const ProbePoint& at);
 
 // Map coordinates (0..1) of a direction in pdf_map's layout.
 void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);

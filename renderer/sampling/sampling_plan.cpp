@@ -159,7 +159,7 @@ DirectionSample SamplingPlan::sample_at(const SurfaceLobe& surface, const Vec3& 
 bool SamplingPlan::stratifies(int depth) const { return sobol && depth >= 0 && depth < qmc::kDepths; }
 
 DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique,
-                                     int depth) const {
+                                     int depth, const SurfaceLobe* surface) const {
   // nee-mis's continuation draws the technique's bits only when it mixes several.
   const bool draws_technique = !nee_mis || continuation_mixes;
   auto u0 = draws_technique ? static_cast<std::int32_t>(rng.next_u32()) : 0;
@@ -178,6 +178,8 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   const std::uint32_t u_target = leaf::draws_target(*this, chosen) ? rng.next_u32() : 0;
   // u1's last cell drawn further where the technique needs it (path.inc's order).
   const float top_log2 = leaf::draws_tail(*this, chosen, u1) ? uniform_tail_log2([&] { return rng.next_u32(); }) : -24.0f;
+  if (surface)
+    return sample_at(*surface, origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2);
   return sample_at(origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2);
 }
 

@@ -174,8 +174,10 @@ struct SamplingPlan {
   // `technique`, when given, receives which technique drew the direction.
   // `depth`: the path depth of the vertex (the camera ray is segment 0), for
   // the `+sobol` sampler's stratified draws; -1: every draw from `rng`.
+  // `surface`: the surface drawn at (the `bsdf` technique's lobe there;
+  // nullptr: lambertian).
   DirectionSample sample(const Vec3& origin, const Vec3& normal, Rng& rng, int* technique = nullptr,
-                         int depth = -1) const;
+                         int depth = -1, const SurfaceLobe* surface = nullptr) const;
   // The same draw from given numbers instead of a stream: u1, u2 in [0, 1)
   // for the direction, 32 bits for the choice of the technique and 32 for the
   // target (used only where the chosen technique draws one). For checking a

@@ -21,6 +21,7 @@ struct Material {
   Vec3 emit{0.0f};
   float fuzz = 0.0f;
   float ior = 1.0f;
+  bool exact_fresnel = false;  // dielectric only: the exact Fresnel reflectance, not Schlick's
   bool two_sided = false;  // diffuse_light only
   // microfacet only: GGX roughness and the conductor's complex index of
   // refraction (relative to the air outside), per channel.

@@ -188,11 +188,17 @@ Material parse_material(const Node& node) {
       if (!(m.fuzz >= 0.0f && m.fuzz <= 1.0f)) f.fail("must be in 0..1");
     }
   } else if (type == "dielectric") {
-    node.allow_only({"type", "ior"});
+    node.allow_only({"type", "ior", "fresnel"});
     m.type = MaterialType::Dielectric;
     const Node ior = node.require("ior");
     m.ior = ior.real();
     if (!(m.ior > 0.0f)) ior.fail("must be > 0");
+    if (node.has("fresnel")) {
+      const Node f = node.child("fresnel");
+      const std::string fresnel = f.string();
+      if (fresnel == "exact") m.exact_fresnel = true;
+      else if (fresnel != "schlick") f.fail("unknown Fresnel term '" + fresnel + "' (schlick, exact)");
+    }
   } else if (type == "diffuse_light") {
     node.allow_only({"type", "emit", "two_sided"});
     m.type = MaterialType::DiffuseLight;

@@ -174,7 +174,11 @@ TEST(ProbeProjection, ProbingAFloorPixelFillsThePanelState) {
   EXPECT_GT(s.technique_counts[0], 100);  // cosine, about half
   EXPECT_GT(s.technique_counts[3], 100);  // light
   EXPECT_EQ(s.strategy_map.values.size(), static_cast<std::size_t>(s.strategy_map.width * s.strategy_map.height));
-  EXPECT_GT(s.light_map.max_value, s.cosine_map.max_value);  // a small light: a sharp lobe
+  EXPECT_GT(s.light_map.max_value, s.bsdf_map.max_value);  // a small light: a sharp lobe
+  // The floor is lambertian: its own lobe is the cosine lobe, cos / pi at most.
+  EXPECT_NE(s.bsdf_lobe.find("cosine lobe"), std::string::npos) << s.bsdf_lobe;
+  EXPECT_NEAR(s.bsdf_map.max_value, 1.0f / 3.14159265f, 0.01f);
+  EXPECT_TRUE(s.delta_note.empty());
   // The check runs in the background and passes for a correct sample/pdf pair.
   start_probe_chi_square(s, 0.0);
   ASSERT_TRUE(s.chi_running());
