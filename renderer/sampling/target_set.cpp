@@ -29,6 +29,10 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   if (!by_point) return;
   int lights = 0;
   for (int j = 0; j < size(); ++j) lights += leaf::target_emits(*this, j) ? 1 : 0;
+  lit_everywhere = false;
+  for (int j = 0; j < size(); ++j)
+    if (leaf::target_emits(*this, j) && (j >= static_cast<int>(quads.size()) || !quads[static_cast<std::size_t>(j)].axes.one_sided))
+      lit_everywhere = true;
   if (lights >= 2)
     for (int j = 0; j < static_cast<int>(quads.size()); ++j)
       if (quads[static_cast<std::size_t>(j)].axes.one_sided) one_sided.push_back(j);

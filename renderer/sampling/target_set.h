@@ -51,6 +51,7 @@ struct TargetSet {
   // Empty where the choice cannot depend on the point (fewer than two lights:
   // a share has nowhere to go).
   std::vector<int> one_sided;
+  bool lit_everywhere = false;  // some light is not one-sided: every point receives from it
   // Whether each target emits (light-sa's glass sphere does not: it keeps its
   // share wherever the point is; empty: all do), and the emitters' total share.
   std::vector<unsigned char> emits;
