@@ -559,19 +559,27 @@ TEST(SamplingPlan, TheSmallestShareIsTwoToTheMinus32) {
       << "a share a hair below 2^-32";
 }
 
+// Two unit lamps at height 5, the first at x = -3, the second at x = 2, of
+// emission `first` and `second`, facing down (the second facing up where asked).
+Scene two_lamps(float first, float second, bool second_faces_up = false) {
+  Scene scene;
+  scene.name = "two lamps";
+  Material a, b;
+  a.type = b.type = MaterialType::DiffuseLight;
+  a.emit = Vec3(first);
+  b.emit = Vec3(second);
+  scene.materials = {a, b};
+  scene.material_names = {"a", "b"};
+  scene.quads.push_back(make_quad(Vec3(-3.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));  // u x v = -y
+  scene.quads.push_back(second_faces_up ? make_quad(Vec3(2.0f, 5, -0.5f), Vec3(0, 0, 1), Vec3(1, 0, 0), 1)
+                                        : make_quad(Vec3(2.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 1));
+  scene.targets = {{Target::Kind::Quad, 0}, {Target::Kind::Quad, 1}};
+  return scene;
+}
+
 TEST(SamplingPlan, PowerRatiosOfABillionAreRealisedInEitherOrder) {
   for (const bool dim_first : {true, false}) {
-    Scene scene;
-    scene.name = "two lamps";
-    Material bright, dim;
-    bright.type = dim.type = MaterialType::DiffuseLight;
-    bright.emit = Vec3(1e9f);
-    dim.emit = Vec3(1.0f);
-    scene.materials = dim_first ? std::vector<Material>{dim, bright} : std::vector<Material>{bright, dim};
-    scene.material_names = {"a", "b"};
-    scene.quads.push_back(make_quad(Vec3(-3.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));
-    scene.quads.push_back(make_quad(Vec3(2.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 1));
-    scene.targets = {{Target::Kind::Quad, 0}, {Target::Kind::Quad, 1}};
+    const Scene scene = dim_first ? two_lamps(1.0f, 1e9f) : two_lamps(1e9f, 1.0f);
     const SamplingPlan plan = SamplingPlan::make(Strategy::parse("light-sa"), scene);
     const int dim_index = dim_first ? 0 : 1;
     const float p_dim = plan.power_targets.quads[static_cast<std::size_t>(dim_index)].probability;
@@ -589,17 +597,7 @@ TEST(SamplingPlan, PowerRatiosOfABillionAreRealisedInEitherOrder) {
 // Light choice by what the point receives (TargetSet::by_point): a dim lamp
 // facing down and one 1e9 times as bright facing up, side by side.
 TEST(SamplingPlan, LightChoiceFollowsWhatThePointReceives) {
-  Scene scene;
-  scene.name = "starved";
-  Material bright, dim;
-  bright.type = dim.type = MaterialType::DiffuseLight;
-  bright.emit = Vec3(1e9f);
-  dim.emit = Vec3(1.0f);
-  scene.materials = {dim, bright};
-  scene.material_names = {"dim", "bright"};
-  scene.quads.push_back(make_quad(Vec3(-3.0f, 5, -0.5f), Vec3(1, 0, 0), Vec3(0, 0, 1), 0));  // u x v = -y
-  scene.quads.push_back(make_quad(Vec3(2.0f, 5, -0.5f), Vec3(0, 0, 1), Vec3(1, 0, 0), 1));   // u x v = +y
-  scene.targets = {{Target::Kind::Quad, 0}, {Target::Kind::Quad, 1}};
+  const Scene scene = two_lamps(1.0f, 1e9f, true);
   for (const char* strategy : {"light-sa", "nee-mis"}) {
     SCOPED_TRACE(strategy);
     const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), scene);

@@ -25,12 +25,14 @@ constexpr int kChiSamples = 200000;
 // a small light or a sharp glossy lobe narrower than a cell still shows.
 constexpr int kSupersample = 8;
 
-ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h) {
+// A map titled `title` whose values `values()` computes; an InputError it
+// throws becomes the map's error line.
+template <class Values>
+ProbeMap make_map_of(const char* title, int w, int h, Values values) {
   ProbeMap map;
   map.title = title;
   try {
-    const SamplingPlan plan = SamplingPlan::make(strategy, scene);
-    map.values = pdf_map(plan, at, w, h, kSupersample);
+    map.values = values();
     map.width = w;
     map.height = h;
     for (float v : map.values)
@@ -41,19 +43,13 @@ ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strateg
   return map;
 }
 
+ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h) {
+  return make_map_of(title, w, h, [&] { return pdf_map(SamplingPlan::make(strategy, scene), at, w, h, kSupersample); });
+}
+
 ProbeMap make_bsdf_map(const Scene& scene, const ProbePoint& at, int w, int h) {
-  ProbeMap map;
-  map.title = "bsdf alone (the material's lobe)";
-  try {
-    map.values = bsdf_pdf_map(scene, at, w, h, kSupersample);
-    map.width = w;
-    map.height = h;
-    for (float v : map.values)
-      if (std::isfinite(v)) map.max_value = std::max(map.max_value, v);
-  } catch (const InputError& e) {
-    map.error = e.what();
-  }
-  return map;
+  return make_map_of("bsdf alone (the material's lobe)", w, h,
+                     [&] { return bsdf_pdf_map(scene, at, w, h, kSupersample); });
 }
 
 // The map as coloured cells. Log scale: four decades below the maximum, so a
