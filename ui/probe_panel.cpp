@@ -329,13 +329,10 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
                                                                 : -1);
     }
     const Scene& sc = *s.scene;
-    const auto label = [&](std::uint32_t material, const char* kind) {
-      const std::string name = material < sc.material_names.size() ? sc.material_names[material] : "target";
-      return name + " (" + kind + ")";
-    };
     s.light_choice = probe_light_choice(sc, *s.plan, s.point);
-    for (const auto& q : s.plan->book_targets.quads) s.target_labels.push_back(label(q.quad->material, "quad"));
-    for (const auto& sp : s.plan->book_targets.spheres) s.target_labels.push_back(label(sp.sphere->material, "sphere"));
+    for (const auto& q : s.plan->book_targets.quads) s.target_labels.push_back(target_label(sc, q.quad->material, "quad"));
+    for (const auto& sp : s.plan->book_targets.spheres)
+      s.target_labels.push_back(target_label(sc, sp.sphere->material, "sphere"));
   }
   s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
                             s.point, kMapWidth, kMapHeight);

@@ -168,9 +168,17 @@ float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction) 
   return plan.pdf(at.surface, at.point, at.normal, direction);
 }
 
+std::string material_name(const Scene& scene, std::uint32_t m, const char* fallback) {
+  return m < scene.material_names.size() ? scene.material_names[m] : fallback;
+}
+
+std::string target_label(const Scene& scene, std::uint32_t material, const char* kind) {
+  return material_name(scene, material, "target") + " (" + kind + ")";
+}
+
 std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at) {
   if (!at.found) return "no surface";
-  const std::string name = at.material < scene.material_names.size() ? scene.material_names[at.material] : "";
+  const std::string name = material_name(scene, at.material);
   if (at.surface.glossy)
     return "GGX visible normals, alpha " + short_number(at.surface.alpha) + " (" + name + ": microfacet)";
   return "cosine lobe (" + name + ": lambertian)";
@@ -179,8 +187,7 @@ std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at) {
 std::string delta_lobe_note(const Scene& scene, const ProbePoint& at) {
   if (at.specular_bounces == 0 || at.first_material >= scene.materials.size()) return {};
   const Material& m = scene.materials[at.first_material];
-  const std::string name = at.first_material < scene.material_names.size() ? scene.material_names[at.first_material]
-                                                                           : "";
+  const std::string name = material_name(scene, at.first_material);
   if (m.type == MaterialType::Dielectric)
     return "The clicked surface is " + name + " (glass, ior " + short_number(m.ior) +
            "): a delta lobe, the mirror direction or the refracted one, chosen by the Fresnel reflectance (" +
@@ -207,18 +214,15 @@ ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan
   }
   if (!set || !at.found || set->empty()) return out;
   const std::vector<float> p = set->probabilities_at(at.point);
-  const auto label = [&](std::uint32_t material, const char* kind) {
-    const std::string name = material < scene.material_names.size() ? scene.material_names[material] : "target";
-    return name + " (" + kind + ")";
-  };
   int j = 0;
   for (const TargetSet::QuadEntry& e : set->quads) {
-    out.rows.push_back({label(e.quad->material, "quad"), e.probability, p[static_cast<std::size_t>(j)],
+    out.rows.push_back({target_label(scene, e.quad->material, "quad"), e.probability, p[static_cast<std::size_t>(j)],
                         set->receives(at.point, j)});
     ++j;
   }
   for (const TargetSet::SphereEntry& e : set->spheres) {
-    out.rows.push_back({label(e.sphere->material, "sphere"), e.probability, p[static_cast<std::size_t>(j)], true});
+    out.rows.push_back({target_label(scene, e.sphere->material, "sphere"), e.probability, p[static_cast<std::size_t>(j)],
+                        true});
     ++j;
   }
   return out;

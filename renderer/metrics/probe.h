@@ -64,6 +64,11 @@ std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at);
 // probe point itself.
 std::string delta_lobe_note(const Scene& scene, const ProbePoint& at);
 
+// The scene's name for material m (`fallback` where it has none).
+std::string material_name(const Scene& scene, std::uint32_t m, const char* fallback = "");
+// A light target's label: its material's name and its shape, e.g. "light (quad)".
+std::string target_label(const Scene& scene, std::uint32_t material, const char* kind);
+
 // Map coordinates (0..1) of a direction in pdf_map's layout.
 void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);
 
