@@ -26,21 +26,23 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
   everywhere.clear();
   everywhere_threshold.clear();
   one_sided.clear();
-  if (!by_point) return;
-  int lights = 0;
-  for (int j = 0; j < size(); ++j) lights += leaf::target_emits(*this, j) ? 1 : 0;
   lit_everywhere = false;
-  for (int j = 0; j < size(); ++j)
-    if (leaf::target_emits(*this, j) && (j >= static_cast<int>(quads.size()) || !quads[static_cast<std::size_t>(j)].axes.one_sided))
-      lit_everywhere = true;
+  emitter_share = 0.0f;
+  if (!by_point) return;
+  // The lights, their total share (summed in the walk's order) and whether
+  // one of them is seen from everywhere (a sphere or a two-sided quad).
+  int lights = 0;
+  for (int j = 0; j < size(); ++j) {
+    if (!leaf::target_emits(*this, j)) continue;
+    ++lights;
+    emitter_share = emitter_share + leaf::target_share(*this, j);
+    if (j >= static_cast<int>(quads.size()) || !quads[static_cast<std::size_t>(j)].axes.one_sided) lit_everywhere = true;
+  }
   if (lights >= 2)
     for (int j = 0; j < static_cast<int>(quads.size()); ++j)
       if (quads[static_cast<std::size_t>(j)].axes.one_sided) one_sided.push_back(j);
-  // The walk of leaf::each_choice for a point that receives from all, in the
-  // same float operations, so that its probabilities are the same numbers.
-  emitter_share = 0.0f;
-  for (int j = 0; j < size(); ++j)
-    if (leaf::target_emits(*this, j)) emitter_share = emitter_share + leaf::target_share(*this, j);
+  // leaf::begin_walk's choice for a point that receives from every light, in
+  // the same float operations, so that its probabilities are the same numbers.
   leaf::TargetChoice c = leaf::begin_choice(*this, emitter_share);
   double below = 0.0;  // C_j: sums of multiples of 2^-24, exact
   for (int j = 0; j < size(); ++j) {
