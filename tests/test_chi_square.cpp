@@ -734,5 +734,115 @@ TEST(ChiSquareVndf, MixturesWithBsdf) {
   }
 }
 
+// ---- The rough dielectric ---------------------------------------------------
+
+// Where the refraction density jumps: directions refracted through the
+// normals on the horizon (D is alpha^2 / pi there, and 0 beyond).
+std::vector<chi_square::Point> horizon_refractions(const Vec3& wo, float eta, const Frame& frame, const Zoom& zoom,
+                                                   const Vec3& n) {
+  std::vector<chi_square::Point> out;
+  const Onb onb(n);
+  for (int i = 0; i < 16384; ++i) {
+    const double phi = 2.0 * 3.14159265358979323846 * (i + 0.5) / 16384;
+    const Vec3 m = onb.to_world(Vec3(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), 0.0f));
+    const float c = dot(wo, m);
+    if (c <= 0.0f || (1.0f - c * c) > eta * eta) continue;  // faces away, or reflects all
+    out.push_back(frame.coordinates(zoom.map(leaf::refract_at(wo, m, c, eta), false)));
+  }
+  return out;
+}
+
+// The bsdf technique at a rough dielectric, from outside (eta 1.5) and from
+// inside (eta 1 / 1.5: total internal reflection past 41.8 degrees), normal to
+// grazing views, alpha 1e-3 to 1, through both samplers (the packet kernel's
+// and the one-path tracer's) against the pdf over the whole sphere. Where the
+// lobes are narrow, the sphere is checked in two halves, each seen through a
+// zoom on its own spike: the side of the surface the reflection leaves to
+// (the draws below it count as missing mass, and the density is zero there),
+// then the side the refraction enters; each half's mass is the density's
+// integral over it, and the two add up to one.
+TEST(ChiSquareRoughDielectric, BothSamplersBothSidesEveryAlpha) {
+  const Scene scene = *make_scene(Targets::None);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("bsdf"), scene);
+  const Vec3 n(0, 0, 1);
+  struct Case {
+    float alpha, view;
+  };
+  const Case cases[] = {{1e-3f, 0.0f}, {1e-3f, 70.0f}, {0.05f, 30.0f}, {0.3f, 85.0f}, {1.0f, 60.0f}};
+  const float etas[] = {1.5f, 1.0f / 1.5f};
+  const double family = stats::sidak_alpha(kFamilyAlpha, 2 * 2 * 2 * static_cast<int>(std::size(cases) * std::size(etas)));
+  std::uint64_t seed = 4100;
+  for (const float eta : etas)
+    for (const Case& c : cases) {
+      const double t = c.view * 3.14159265358979323846 / 180.0;
+      const Vec3 wo(static_cast<float>(std::sin(t)), 0.0f, static_cast<float>(std::cos(t)));
+      const SurfaceLobe surface{true, c.alpha, wo, true, eta};
+      const bool split = c.alpha < 0.2f;
+      const bool refracts = std::sin(t) < eta;  // the smooth refraction exists (the zoom's axis)
+      double total = 0.0;
+      for (const int side : {1, -1}) {
+        if (!split && side < 0) break;
+        const Vec3 axis = side < 0 && refracts ? leaf::refract_at(wo, n, wo.z, eta) : side < 0 ? Vec3(0, 0, -1)
+                                                                                           : leaf::reflect(-wo, n);
+        const Zoom zoom(axis, split ? std::min(1.0, 3.0 * c.alpha) : 1.0);
+        const Frame frame(Vec3(zoom.axis));
+        // The draws and the density on this side of the surface alone (or everywhere).
+        const auto kept = [&](const Vec3& d) { return !split || (side > 0 ? d.z > 0.0f : d.z <= 0.0f); };
+        std::vector<chi_square::Draw> draws;
+        for (const Sampler which : {Sampler::Packet, Sampler::OnePath})
+          draws.push_back([zoom, kept, d = chi_square::plan_sampler(plan, Vec3(0.0f), n, which, surface)](Rng& rng) mutable {
+            DirectionSample s = d(rng);
+            if (!kept(s.direction)) s.none = true;
+            return through_zoom(zoom, s);
+          });
+        auto density = [&](const Vec3& zoomed) {
+          double factor = 1.0;
+          const Vec3 d = zoom.map(zoomed, true, &factor);
+          return kept(d) ? static_cast<double>(plan.pdf(surface, Vec3(0.0f), n, d)) * factor : 0.0;
+        };
+        std::vector<chi_square::Point> edges = horizon_reflections(wo, frame, zoom, n);
+        for (const chi_square::Point& p : horizon_refractions(wo, eta, frame, zoom, n)) edges.push_back(p);
+        for (int i = 0; i < 4096; ++i) {  // the surface's plane, where a split density stops
+          const double phi = 2.0 * 3.14159265358979323846 * (i + 0.5) / 4096;
+          edges.push_back(frame.coordinates(
+              zoom.map(Vec3(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)), 0.0f), false)));
+        }
+        const std::vector<Outcome> both = chi_square::run_each(kGrid, frame, draws, density, edges, seed++, 100'000);
+        for (std::size_t k = 0; k < both.size(); ++k) {
+          const Outcome& o = both[k];
+          std::printf("[rough] %s eta %.3g alpha %-6g view %2g %s: p = %.3g, integral %.6f\n",
+                      k == 0 ? "packet  " : "one-path", eta, c.alpha, c.view,
+                      !split ? "whole sphere" : side > 0 ? "reflection side" : "refraction side", o.chi.p_value,
+                      o.integral);
+          EXPECT_TRUE(o.passed(family)) << (k == 0 ? "packet" : "one-path") << " eta " << eta << " alpha " << c.alpha
+                                        << " view " << c.view << " side " << side << ": p = " << o.chi.p_value
+                                        << ", zero-cell hits " << o.chi.zero_cell_hits << ", bad pdfs " << o.bad_pdf;
+        }
+        total += both[0].integral;
+      }
+      EXPECT_NEAR(total, 1.0, 3e-3) << "eta " << eta << " alpha " << c.alpha << " view " << c.view;
+    }
+}
+
+// The harness sees a wrong refraction density: samples judged against a
+// density whose refraction lobe lacks Walter's eta^2 in the Jacobian (the
+// lobe's mass then 1 / eta^2 of what is drawn) must fail.
+TEST(ChiSquareRoughDielectric, RejectsAWrongJacobian) {
+  const Scene scene = *make_scene(Targets::None);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("bsdf"), scene);
+  const Vec3 n(0, 0, 1), wo(std::sin(0.5f), 0.0f, std::cos(0.5f));
+  const float eta = 1.5f, alpha = 0.3f;
+  const SurfaceLobe surface{true, alpha, wo, true, eta};
+  const Frame frame(n);
+  auto density = [&](const Vec3& d) {
+    const double p = plan.pdf(surface, Vec3(0.0f), n, d);
+    return d.z < 0.0f ? p / (eta * eta) : p;  // roughly the lobe without its eta^2
+  };
+  const Outcome o = run_chi_square(frame, chi_square::plan_sampler(plan, Vec3(0.0f), n, Sampler::OnePath, surface),
+                                   density, {}, 4190, 100'000);
+  std::printf("[rough] judged without eta^2: p = %.3g\n", o.chi.p_value);
+  EXPECT_LT(o.chi.p_value, 1e-6);
+}
+
 }  // namespace
 }  // namespace pdflab

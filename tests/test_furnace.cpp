@@ -338,5 +338,99 @@ TEST(MicrofacetFurnace, EnergyAtMostOne) {
     }
 }
 
+// The rough dielectric (frosted glass), from outside (eta 1.5) and from
+// inside (eta 1 / 1.5, total internal reflection past 41.8 degrees): its
+// albedo, f |cos| over the whole sphere, estimated with its own sampler, is
+// at most one; the reflected part and the transmitted part each agree with
+// the same integrals by uniform sampling of the sphere where the lobes are
+// wide enough for that; and near alpha 0 they are the smooth interface's
+// exact Fresnel R and 1 - R (no 1 / eta^2: the book's glass convention).
+TEST(RoughDielectricFurnace, EnergyAtMostOneAndSmoothLimit) {
+  constexpr int kN = 100'000;
+  const float etas[] = {1.5f, 1.0f / 1.5f};
+  for (const float eta : etas)
+    for (const float alpha : kAlphas)
+      for (const float view : kViewDegrees) {
+        const Vec3 wo = view_at(view);
+        Rng rng(91, 7);
+        double sum = 0.0, sum2 = 0.0, reflected = 0.0, uniform_r = 0.0, uniform_t = 0.0, ur2 = 0.0, ut2 = 0.0;
+        for (int i = 0; i < kN; ++i) {
+          const float u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+          float s, c;
+          sincos_2pi(u2, s, c);
+          const Vec3 wi = leaf::rough_dielectric_sample(wo, alpha, eta, u1, s, c, u3);
+          const float pdf = leaf::rough_dielectric_pdf(wo, wi, alpha, eta);
+          ASSERT_TRUE(pdf > 0.0f && std::isfinite(pdf)) << "eta " << eta << " alpha " << alpha << " view " << view;
+          const double w = leaf::rough_dielectric_value(wo, wi, alpha, eta) / pdf;
+          sum += w;
+          sum2 += w * w;
+          if (wi.z > 0.0f) reflected += w;
+          // The same integrals by uniform directions over the sphere.
+          const float v1 = rng.uniform(), v2 = rng.uniform();
+          sincos_2pi(v2, s, c);
+          const Vec3 d = leaf::uniform_sphere_direction(v1, s, c);
+          const double wu = leaf::rough_dielectric_value(wo, d, alpha, eta) * (4.0 * 3.14159265358979323846);
+          (d.z > 0.0f ? uniform_r : uniform_t) += wu;
+          (d.z > 0.0f ? ur2 : ut2) += wu * wu;
+        }
+        SCOPED_TRACE("eta " + std::to_string(eta) + ", alpha " + std::to_string(alpha) + ", view " +
+                     std::to_string(view));
+        const double mean = sum / kN, se = std::sqrt(std::max(0.0, sum2 / kN - mean * mean) / kN);
+        EXPECT_LE(mean, 1.0 + 4.0 * se + 1e-6);
+        EXPECT_GT(mean, 0.3);
+        const double r = reflected / kN, t = mean - r;
+        if (alpha >= 0.2f && view <= 75.0f) {
+          const double mr = uniform_r / kN, mt = uniform_t / kN;
+          const double sr = std::sqrt(std::max(0.0, ur2 / kN - mr * mr) / kN),
+                       st = std::sqrt(std::max(0.0, ut2 / kN - mt * mt) / kN);
+          // The sampler's split has its own noise: at most that of the total.
+          EXPECT_NEAR(r, mr, 5.0 * std::hypot(sr, se));
+          EXPECT_NEAR(t, mt, 5.0 * std::hypot(st, se));
+        }
+        if (alpha <= 1e-3f && view <= 75.0f) {
+          const float cos_o = wo.z, ratio = 1.0f / eta;
+          const float fresnel =
+              leaf::fresnel_dielectric(cos_o, ratio, ratio * ratio * (1.0f - cos_o * cos_o));
+          EXPECT_NEAR(r, fresnel, 0.01);
+          EXPECT_NEAR(t, 1.0 - fresnel, 0.01);
+        }
+      }
+}
+
+// Reciprocity across the interface: with f = value / |cos_i|, the rough
+// dielectric's f(wo, wi) = f(wi, wo) for a reflection and eta^2 f(wi, wo) for a
+// refraction (the adjoint of the radiance BTDF, which divides by eta^2), seen
+// from wi's side with the surface turned over (z negated, eta inverted).
+TEST(RoughDielectricFurnace, Reciprocity) {
+  Rng rng(5, 11);
+  int refractions = 0, reflections = 0;
+  for (const float eta : {1.5f, 1.0f / 1.33f})
+    for (const float alpha : {0.05f, 0.3f, 1.0f})
+      for (int i = 0; i < 4000; ++i) {
+        float s, c;
+        sincos_2pi(rng.uniform(), s, c);
+        Vec3 wo = leaf::uniform_sphere_direction(rng.uniform(), s, c);
+        wo.z = std::fabs(wo.z);
+        sincos_2pi(rng.uniform(), s, c);
+        const Vec3 wi = leaf::uniform_sphere_direction(rng.uniform(), s, c);
+        if (wo.z < 0.05f || std::fabs(wi.z) < 0.05f) continue;
+        const double forward = leaf::rough_dielectric_value(wo, wi, alpha, eta) / std::fabs(wi.z);
+        const bool refracts = wi.z < 0.0f;
+        const Vec3 back_wo = refracts ? Vec3(wi.x, wi.y, -wi.z) : wi;
+        const Vec3 back_wi = refracts ? Vec3(wo.x, wo.y, -wo.z) : wo;
+        const float back_eta = refracts ? 1.0f / eta : eta;
+        const double backward = leaf::rough_dielectric_value(back_wo, back_wi, alpha, back_eta) / wo.z;
+        const double expected = refracts ? eta * eta * backward : backward;
+        if (forward < 1e-4 && expected < 1e-4) continue;
+        (refracts ? refractions : reflections) += 1;
+        // (plus float's rounding near the critical angle, where 1 - F is all that is left)
+        EXPECT_NEAR(forward, expected, 2e-3 * std::max(forward, expected) + 3e-6)
+            << "eta " << eta << " alpha " << alpha << " wo " << wo.x << "," << wo.y << "," << wo.z << " wi " << wi.x
+            << "," << wi.y << "," << wi.z;
+      }
+  EXPECT_GT(refractions, 1000);
+  EXPECT_GT(reflections, 1000);
+}
+
 }  // namespace
 }  // namespace pdflab

@@ -583,10 +583,58 @@ TEST(SceneLoader, MicrofacetRefusesBadParameters) {
   }
   m = good;
   m["fuzz"] = 0.1;
-  expect_error_mentions(with_microfacet(m), {"unknown key 'fuzz'", "alpha, eta, k, type"});
+  expect_error_mentions(with_microfacet(m), {"unknown key 'fuzz'", "alpha, eta, ior, k, type"});
   m = good;
   m["type"] = "microfacets";
   expect_error_mentions(with_microfacet(m), {"unknown material type", "microfacet)"});
+}
+
+// ---- The rough dielectric -------------------------------------------------------
+
+TEST(SceneLoader, RoughDielectricLoads) {
+  const json doc = with_microfacet(json::parse(R"({"type": "microfacet", "alpha": 0.2, "ior": 1.5})"));
+  const Scene s = load_scene_text(doc.dump(), "scene.json");
+  const Material& m = s.materials[s.spheres[0].material];
+  EXPECT_EQ(m.type, MaterialType::Microfacet);
+  EXPECT_TRUE(m.transmits);
+  EXPECT_FLOAT_EQ(m.alpha, 0.2f);
+  EXPECT_FLOAT_EQ(m.ior, 1.5f);
+  // The conductor does not transmit.
+  const json conductor =
+      with_microfacet(json::parse(R"({"type": "microfacet", "alpha": 0.2, "eta": [1, 1, 1], "k": [3, 3, 3]})"));
+  EXPECT_FALSE(load_scene_text(conductor.dump(), "scene.json").materials[s.spheres[0].material].transmits);
+  // The shipped frosted glass scene loads, with its sphere frosted.
+  const Scene frosted = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/frosted_glass.json");
+  bool found = false;
+  for (const Material& fm : frosted.materials) found = found || (fm.type == MaterialType::Microfacet && fm.transmits);
+  EXPECT_TRUE(found);
+}
+
+TEST(SceneLoader, RoughDielectricRefusesBadCombinations) {
+  const json good = json::parse(R"({"type": "microfacet", "alpha": 0.2, "ior": 1.5})");
+  // A conductor's index beside a dielectric's: which one is meant is unclear.
+  for (const char* key : {"eta", "k"}) {
+    json m = good;
+    m[key] = {1, 1, 1};
+    expect_error_mentions(with_microfacet(m), {"materials.rough.ior", "conductor ('eta' and 'k') or a dielectric ('ior')"});
+  }
+  for (const double ior : {0.0, -1.5}) {
+    json m = good;
+    m["ior"] = ior;
+    expect_error_mentions(with_microfacet(m), {"materials.rough.ior", "> 0"});
+  }
+  json m = good;
+  m["ior"] = 1.0;
+  expect_error_mentions(with_microfacet(m), {"materials.rough.ior", "must not be 1"});
+  m = good;
+  m.erase("ior");
+  expect_error_mentions(with_microfacet(m), {"materials.rough", "needs 'eta' and 'k' (a conductor) or 'ior' (a dielectric)"});
+  m = good;
+  m["alpha"] = 2.0;
+  expect_error_mentions(with_microfacet(m), {"materials.rough.alpha", "0.001..1"});
+  m = good;
+  m["fresnel"] = "exact";
+  expect_error_mentions(with_microfacet(m), {"unknown key 'fresnel'"});
 }
 
 }  // namespace

@@ -453,8 +453,9 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   if (!s.delta_note.empty()) ImGui::TextWrapped("%s", s.delta_note.c_str());
   if (s.point.surface.glossy && s.plan && !s.plan->nee_mis && s.plan->weight[static_cast<int>(Technique::Bsdf)] > 0.0f) {
     ImGui::PushStyleColor(ImGuiCol_Text, kDim);
-    ImGui::TextWrapped("The chi-square check below draws bsdf at a lambertian lobe; the VNDF sampler's own check is "
-                       "test_chi_square's ChiSquareVndf.");
+    ImGui::TextWrapped("The chi-square check below draws bsdf at this point's own lobe (%s).",
+                       s.point.surface.transmits ? "GGX visible normals, reflected or refracted"
+                                                 : "GGX visible normals, reflected");
     ImGui::PopStyleColor();
   }
 

@@ -77,6 +77,10 @@ struct PlanDraw {
   // log2(1 - u1) where u1 is its largest value (kLargestUniform) and the
   // technique draws the tail (leaf::Shading::top_log2); -24: undrawn.
   float top_log2 = -24.0f;
+  // The surface drawn at (the `bsdf` technique's lobe: lambertian unless
+  // glossy) and, at a rough dielectric, the number choosing reflection or refraction.
+  SurfaceLobe surface{};
+  float u_lobe = 0.0f;
 };
 void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out);
 // The mixture's density for `directions[i]` at draws[i]'s point (its random numbers unused).

@@ -164,6 +164,7 @@ struct PacketDraws {
   static constexpr std::size_t kBatch = 256;
   const SamplingPlan* plan;
   Vec3 origin, normal;
+  SurfaceLobe surface;
   std::vector<DirectionSample> batch;
   std::size_t next = 0;
 
@@ -175,6 +176,8 @@ struct PacketDraws {
         d.u0 = rng.next_u32(), d.u1 = rng.uniform(), d.u2 = rng.uniform(), d.u_choice = rng.next_u32();
         // u1's last cell drawn further (used by the techniques that draw the tail).
         if (d.u1 == kLargestUniform) d.top_log2 = uniform_tail_log2([&] { return rng.next_u32(); });
+        d.surface = surface;
+        if (surface.glossy && surface.transmits) d.u_lobe = rng.uniform();
       }
       batch.resize(kBatch);
       sample_plan(best_packet_isa(), *plan, draws.data(), draws.size(), batch.data());
@@ -399,26 +402,29 @@ Outcome run(const Grid& grid, const Frame& frame, const Draw& draw, const Densit
   return std::move(run_each(grid, frame, {draw}, density, edges, seed, samples).front());
 }
 
-Draw plan_sampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which) {
-  if (which == Sampler::Packet) return PacketDraws{&plan, origin, normal, {}, 0};
-  return [&plan, origin, normal](Rng& rng) { return plan.sample(origin, normal, rng); };
+Draw plan_sampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which,
+                  const SurfaceLobe& surface) {
+  if (which == Sampler::Packet) return PacketDraws{&plan, origin, normal, surface, {}, 0};
+  return [&plan, origin, normal, surface](Rng& rng) {
+    return plan.sample(origin, normal, rng, nullptr, -1, &surface);
+  };
 }
 
 std::vector<Outcome> check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal,
                                 const std::vector<Sampler>& samplers, int samples, std::uint64_t seed,
-                                const Grid& grid) {
+                                const Grid& grid, const SurfaceLobe& surface) {
   const Frame frame(normal);
-  const Density density = [&](const Vec3& d) { return static_cast<double>(plan.pdf(origin, normal, d)); };
+  const Density density = [&](const Vec3& d) { return static_cast<double>(plan.pdf(surface, origin, normal, d)); };
   const std::vector<Point> edges = plan_edges(plan, origin, normal, frame);
   std::vector<Draw> draws;
-  for (Sampler which : samplers) draws.push_back(plan_sampler(plan, origin, normal, which));
+  for (Sampler which : samplers) draws.push_back(plan_sampler(plan, origin, normal, which, surface));
   const Grid rows = grid.lobe_rows && grid.z_edges.empty() ? follow_lobe(grid, frame, density) : grid;
   return run_each(rows, frame, draws, density, edges, seed, samples);
 }
 
 Outcome check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which, int samples,
-                   std::uint64_t seed, const Grid& grid) {
-  return std::move(check_plan(plan, origin, normal, std::vector<Sampler>{which}, samples, seed, grid).front());
+                   std::uint64_t seed, const Grid& grid, const SurfaceLobe& surface) {
+  return std::move(check_plan(plan, origin, normal, std::vector<Sampler>{which}, samples, seed, grid, surface).front());
 }
 
 }  // namespace pdflab::chi_square

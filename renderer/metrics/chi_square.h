@@ -109,17 +109,20 @@ std::vector<Outcome> run_each(const Grid& grid, const Frame& frame, const std::v
 // tracer calls. Packet: the packet kernel's sample_plan on the best ISA, what
 // renders, in batches, with the same four random numbers per draw.
 enum class Sampler { OnePath, Packet };
-Draw plan_sampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which);
+// `surface`: the surface drawn at (the `bsdf` technique's lobe; default lambertian).
+Draw plan_sampler(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which,
+                  const SurfaceLobe& surface = {});
 
 // The whole check of a plan's mixture at a shading point: the outlines of the
 // plan's scene's targets and its techniques' own edges, the mixture's pdf, the
 // chosen sampler, on `grid`'s rows or, where it asks for them (lobe_rows) and
 // the lobe is narrow, rows of equal mass (follow_lobe).
+// At `surface` (default lambertian), for the `bsdf` technique's lobe there.
 Outcome check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal, Sampler which, int samples,
-                   std::uint64_t seed, const Grid& grid = {});
+                   std::uint64_t seed, const Grid& grid = {}, const SurfaceLobe& surface = {});
 // ... for several samplers, in that order, against one integration.
 std::vector<Outcome> check_plan(const SamplingPlan& plan, const Vec3& origin, const Vec3& normal,
                                 const std::vector<Sampler>& samplers, int samples, std::uint64_t seed,
-                                const Grid& grid = {});
+                                const Grid& grid = {}, const SurfaceLobe& surface = {});
 
 }  // namespace pdflab::chi_square

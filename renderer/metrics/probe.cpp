@@ -31,6 +31,8 @@ ProbePoint first_diffuse_hit(const Scene& scene, int x, int y, std::uint64_t see
       at.surface.glossy = m.type == MaterialType::Microfacet;
       at.surface.alpha = m.alpha;
       at.surface.outgoing = normalize(-ray.direction);
+      at.surface.transmits = m.type == MaterialType::Microfacet && m.transmits;
+      at.surface.eta = front ? m.ior : 1.0f / m.ior;  // n beyond the surface over n on the ray's side
       return at;
     }
     if (m.type == MaterialType::DiffuseLight) return at;
@@ -179,6 +181,9 @@ std::string target_label(const Scene& scene, std::uint32_t material, const char*
 std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at) {
   if (!at.found) return "no surface";
   const std::string name = material_name(scene, at.material);
+  if (at.surface.glossy && at.surface.transmits)
+    return "GGX visible normals, alpha " + short_number(at.surface.alpha) + ", reflected or refracted (" + name +
+           ": rough dielectric, eta " + short_number(at.surface.eta) + ")";
   if (at.surface.glossy)
     return "GGX visible normals, alpha " + short_number(at.surface.alpha) + " (" + name + ": microfacet)";
   return "cosine lobe (" + name + ": lambertian)";
@@ -240,7 +245,8 @@ ProbeChiSquare probe_chi_square(const SamplingPlan& plan, const ProbePoint& at, 
   if (!at.found || plan.nee_mis) return out;  // nee-mis draws two directions; see probe_directions
   const chi_square::Grid grid{z_cells, phi_cells};
   std::vector<chi_square::Outcome> both = chi_square::check_plan(
-      plan, at.point, at.normal, {chi_square::Sampler::Packet, chi_square::Sampler::OnePath}, samples, seed, grid);
+      plan, at.point, at.normal, {chi_square::Sampler::Packet, chi_square::Sampler::OnePath}, samples, seed, grid,
+      at.surface);
   chi_square::Outcome& packet = both[0];
   const chi_square::Outcome& one_path = both[1];
   out.result = packet.chi;

@@ -134,6 +134,8 @@ void set_surface(leaf::Shading& at, const SurfaceLobe& surface) {
   at.glossy = surface.glossy;
   at.alpha = surface.alpha;
   at.outgoing = surface.outgoing;
+  at.transmits = surface.glossy && surface.transmits;
+  at.eta = surface.eta;
 }
 }  // namespace
 
@@ -146,13 +148,14 @@ float SamplingPlan::pdf(const SurfaceLobe& surface, const Vec3& origin, const Ve
 
 DirectionSample SamplingPlan::sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1,
                                         float u2, std::uint32_t u_technique, std::uint32_t u_target,
-                                        int* technique, float top_log2) const {
+                                        int* technique, float top_log2, float u_lobe) const {
   const int chosen = leaf::choose_technique(*this, static_cast<std::int32_t>(u_technique));
   if (technique) *technique = chosen;
   const auto u_choice = leaf::draws_target(*this, chosen) ? static_cast<std::int32_t>(u_target) : 0;
   leaf::Shading at(*this, origin, normal, u1, u2, u_choice);
   set_surface(at, surface);
   at.top_log2 = top_log2;
+  at.u_lobe = u_lobe;
   return to_direction_sample(leaf::sample_mixture(*this, at, chosen, true));
 }
 
@@ -176,10 +179,13 @@ DirectionSample SamplingPlan::sample(const Vec3& origin, const Vec3& normal, Rng
   const int chosen = leaf::choose_technique(*this, u0);
   if (technique) *technique = chosen;
   const std::uint32_t u_target = leaf::draws_target(*this, chosen) ? rng.next_u32() : 0;
+  // A rough dielectric's choice of reflection or refraction (path.inc's order).
+  const float u_lobe = surface && surface->glossy && surface->transmits ? rng.uniform() : 0.0f;
   // u1's last cell drawn further where the technique needs it (path.inc's order).
   const float top_log2 = leaf::draws_tail(*this, chosen, u1) ? uniform_tail_log2([&] { return rng.next_u32(); }) : -24.0f;
   if (surface)
-    return sample_at(*surface, origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2);
+    return sample_at(*surface, origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2,
+                     u_lobe);
   return sample_at(origin, normal, u1, u2, static_cast<std::uint32_t>(u0), u_target, nullptr, top_log2);
 }
 

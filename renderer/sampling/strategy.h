@@ -123,11 +123,15 @@ inline Strategy with_roulette(Strategy strategy, int depth) {
 
 // The surface a continuation is drawn at, for the `bsdf` technique: lambertian
 // (its lobe is the cosine lobe), or a microfacet conductor of GGX roughness
-// `alpha` seen from `outgoing` (unit, on the normal's side).
+// `alpha` seen from `outgoing` (unit, on the normal's side); where
+// `transmits`, a rough dielectric of relative index `eta` (the index beyond
+// the surface over the index on the normal's side).
 struct SurfaceLobe {
   bool glossy = false;
   float alpha = 1.0f;
   Vec3 outgoing{0.0f, 0.0f, 1.0f};
+  bool transmits = false;
+  float eta = 1.0f;
 };
 
 // A strategy bound to a scene: normalised weights, the techniques' cumulative
@@ -186,10 +190,11 @@ struct SamplingPlan {
   // and the technique draws the tail (leaf::Shading::top_log2; -24: undrawn).
   DirectionSample sample_at(const Vec3& origin, const Vec3& normal, float u1, float u2, std::uint32_t u_technique,
                             std::uint32_t u_target, int* technique = nullptr, float top_log2 = -24.0f) const;
-  // The same at a given surface (the `bsdf` technique's lobe there).
+  // The same at a given surface (the `bsdf` technique's lobe there); `u_lobe`
+  // in [0, 1) chooses reflection or refraction at a rough dielectric.
   DirectionSample sample_at(const SurfaceLobe& surface, const Vec3& origin, const Vec3& normal, float u1, float u2,
                             std::uint32_t u_technique, std::uint32_t u_target, int* technique = nullptr,
-                            float top_log2 = -24.0f) const;
+                            float top_log2 = -24.0f, float u_lobe = 0.0f) const;
   // The mixture's pdf for any unit direction (aimed_quad: as TargetSet::pdf).
   float pdf(const Vec3& origin, const Vec3& normal, const Vec3& direction, int aimed_quad = -1,
             float aimed_t = 0.0f) const;

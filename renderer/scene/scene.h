@@ -10,9 +10,12 @@
 
 namespace pdflab {
 
-// Microfacet: a rough conductor (GGX / Trowbridge-Reitz normals of roughness
-// `alpha`, the exact conductor Fresnel of the complex index eta + i k per
-// channel, height-correlated Smith masking-shadowing), reflecting only.
+// Microfacet: a rough surface of GGX / Trowbridge-Reitz normals of roughness
+// `alpha` with height-correlated Smith masking-shadowing: a conductor (the
+// exact conductor Fresnel of the complex index eta + i k per channel),
+// reflecting only, or where `transmits` a rough dielectric of index `ior`
+// (Walter et al. 2007: reflection and refraction through one microfacet,
+// chosen by the exact dielectric Fresnel term).
 enum class MaterialType : std::uint8_t { Lambertian, Metal, Dielectric, DiffuseLight, Microfacet };
 
 struct Material {
@@ -28,6 +31,9 @@ struct Material {
   float alpha = 1.0f;
   Vec3 eta{1.0f};
   Vec3 k{0.0f};
+  // microfacet only: a rough dielectric (frosted glass) of index `ior`
+  // (relative to the air outside; the front side is outside), not a conductor.
+  bool transmits = false;
 };
 
 // The microfacet roughness range the loader accepts: below 1e-3 the lobe is

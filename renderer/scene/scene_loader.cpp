@@ -205,19 +205,34 @@ Material parse_material(const Node& node) {
     m.emit = nonnegative_colour(node.require("emit"));
     m.two_sided = node.has("two_sided") && node.child("two_sided").boolean();
   } else if (type == "microfacet") {
-    node.allow_only({"type", "alpha", "eta", "k"});
+    node.allow_only({"type", "alpha", "eta", "k", "ior"});
     m.type = MaterialType::Microfacet;
     const Node alpha = node.require("alpha");
     m.alpha = alpha.real();
     if (!(m.alpha >= kMinMicrofacetAlpha && m.alpha <= 1.0f)) alpha.fail("must be in 0.001..1 (the GGX roughness)");
-    const Node eta = node.require("eta");
-    m.eta = eta.vec3();
-    if (!(m.eta.x > 0.0f && m.eta.y > 0.0f && m.eta.z > 0.0f))
-      eta.fail("components must be > 0 (the real part of the conductor's index of refraction)");
-    const Node k = node.require("k");
-    m.k = k.vec3();
-    if (!(m.k.x >= 0.0f && m.k.y >= 0.0f && m.k.z >= 0.0f))
-      k.fail("components must be >= 0 (the imaginary part of the conductor's index of refraction)");
+    if (node.has("ior")) {
+      // A rough dielectric: its index is all it has (no eta + i k).
+      const Node ior = node.child("ior");
+      if (node.has("eta") || node.has("k"))
+        ior.fail("a microfacet material is a conductor ('eta' and 'k') or a dielectric ('ior'), not both");
+      m.transmits = true;
+      m.ior = ior.real();
+      if (!(m.ior > 0.0f) || !std::isfinite(m.ior)) ior.fail("must be > 0 (the dielectric's index of refraction)");
+      if (m.ior == 1.0f)
+        ior.fail("must not be 1: a dielectric of the outside's index neither reflects nor bends light (its "
+                 "transmission is a delta, which has no density)");
+    } else {
+      if (!node.has("eta") && !node.has("k"))
+        node.fail("a microfacet material needs 'eta' and 'k' (a conductor) or 'ior' (a dielectric)");
+      const Node eta = node.require("eta");
+      m.eta = eta.vec3();
+      if (!(m.eta.x > 0.0f && m.eta.y > 0.0f && m.eta.z > 0.0f))
+        eta.fail("components must be > 0 (the real part of the conductor's index of refraction)");
+      const Node k = node.require("k");
+      m.k = k.vec3();
+      if (!(m.k.x >= 0.0f && m.k.y >= 0.0f && m.k.z >= 0.0f))
+        k.fail("components must be >= 0 (the imaginary part of the conductor's index of refraction)");
+    }
   } else {
     type_node.fail("unknown material type '" + type + "' (lambertian, metal, dielectric, diffuse_light, microfacet)");
   }
