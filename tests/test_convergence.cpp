@@ -388,6 +388,40 @@ TEST(Convergence, VeachSceneEveryUnbiasedStrategyAgrees) {
   }
 }
 
+// The book's box with its glass sphere frosted (assets/scenes/frosted_glass.json:
+// a rough dielectric, GGX alpha 0.2, ior 1.5): every unbiased strategy
+// converges to one image, those with bsdf drawing the sphere's reflection and
+// refraction in their mixture, those without drawing there with its own lobe,
+// nee-mis weighing the light sample (also through the sphere) against the
+// continuation. Depth 4: light refracted into the sphere and out again.
+TEST(Convergence, FrostedGlassEveryUnbiasedStrategyAgrees) {
+  constexpr int kSmall = 24;
+  struct Run {
+    const char* strategy;
+    std::uint32_t spp;
+  };
+  const Run runs[] = {{"bsdf", 1024},
+                      {"cosine", 1024},
+                      {"mix:cosine=0.5,light=0.5", 512},
+                      {"mix:bsdf=0.5,light-sa=0.5+rr:2", 512},
+                      {"nee-mis", 256},
+                      {"nee-mis:balance+bsdf", 256},
+                      {"nee-mis+mix:bsdf=0.5,light-sa=0.5+sobol", 256}};
+  const int tests = static_cast<int>(std::size(runs)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
+  const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
+  std::uint64_t seed = 4300;
+  const auto scene = small_shipped_scene("frosted_glass.json", 4);
+  const BlockImage reference = render_blocks("nee-mis+bsdf", seed++, 4096, scene);
+  for (const Run& run : runs) {
+    SCOPED_TRACE(run.strategy);
+    const Comparison cmp = compare(render_blocks(run.strategy, seed++, run.spp, scene), reference);
+    std::printf("[convergence] frosted_glass.json depth 4 %-40s block z in [%+.2f, %+.2f] (limit %.2f)\n",
+                run.strategy, cmp.most_negative, cmp.most_positive, limit);
+    for (std::size_t i = 0; i < cmp.z.size(); ++i)
+      EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
+  }
+}
+
 // The book's box with its glass sphere on the exact Fresnel term
 // ("fresnel": "exact"): every unbiased strategy, the ones aimed at the glass
 // sphere among them, converges to one image. (At this size the Schlick image

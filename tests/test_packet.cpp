@@ -24,7 +24,7 @@ namespace {
 
 const char* const kScenes[] = {"cornell_book.json", "small_light.json",  "large_light.json",      "two_lights.json",
                                "far_light.json",    "glossy_metal.json", "cornell_aluminium.json",
-                               "veach_mis.json",    "starved_light.json"};
+                               "veach_mis.json",    "starved_light.json", "frosted_glass.json"};
 // The strategies of the options and their combinations; every technique of
 // the table, alone and mixed with cosine, is added (tests/table_strategies.h).
 const char* const kStrategies[] = {"mix:cosine=0.5,light=0.5",

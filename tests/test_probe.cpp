@@ -239,5 +239,66 @@ TEST(Probe, TheBsdfLobeSaysWhatItIs) {
   EXPECT_NE(note.find("delta lobe"), std::string::npos) << note;
 }
 
+// The in-app chi-square check at a microfacet point tests the bsdf technique
+// against that point's own lobe: GGX's visible normals reflected on Veach's
+// plates (alpha 0.07 and 0.005; the expected counts then crowd into a few cells, where a cosine lobe
+// would spread over the hemisphere), reflected or refracted on the frosted
+// sphere (most of the expected mass below the surface, where a reflecting lobe
+// has none). Both samplers pass there, alone and mixed with light-sa.
+TEST(Probe, ChiSquareCheckUsesTheClickedPointsOwnLobe) {
+  const auto largest_share = [](const ProbeChiSquare& c) {
+    double total = 0.0;
+    for (double e : c.expected) total += e;
+    return *std::max_element(c.expected.begin(), c.expected.end()) / total;
+  };
+  const auto share_below = [](const ProbeChiSquare& c) {
+    double total = 0.0, below = 0.0;
+    for (std::size_t i = 0; i < c.expected.size(); ++i) {
+      total += c.expected[i];
+      if (static_cast<int>(i) / c.phi_cells >= c.z_cells / 2) below += c.expected[i];
+    }
+    return below / total;
+  };
+  const char* strategies[] = {"bsdf", "mix:bsdf=0.5,light-sa=0.5"};
+  const Scene v = veach();
+  for (const char* name : {"plate2", "plate4"}) {
+    const ProbePoint at = find_point(v, name);
+    ASSERT_TRUE(at.found && at.surface.glossy) << name;
+    for (const char* st : strategies) {
+      const ProbeChiSquare c = probe_chi_square(SamplingPlan::make(Strategy::parse(st), v), at, 20000, 13, 16, 32, 1e-3);
+      EXPECT_TRUE(c.passed) << name << " " << st << ": p " << c.result.p_value;
+      std::printf("[probe] %s %s: p %.3g, largest cell %.3f of the expected mass\n", name, st, c.result.p_value,
+                  largest_share(c));
+      if (std::string(st) == "bsdf") {
+        EXPECT_GT(largest_share(c), 0.05) << name;  // a cosine lobe: below 0.01
+      }
+    }
+  }
+  Scene f = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/frosted_glass.json");
+  f.camera.width = f.camera.height = 100;
+  f.prepare();
+  ProbePoint at;
+  for (int y = 60; y < 100 && !at.found; ++y)
+    for (int x = 0; x < 100; ++x) {
+      const ProbePoint p = first_diffuse_hit(f, x, y);
+      if (p.found && p.surface.transmits) {
+        at = p;
+        break;
+      }
+    }
+  ASSERT_TRUE(at.found) << "no pixel sees the frosted sphere";
+  EXPECT_FLOAT_EQ(at.surface.eta, 1.5f);  // seen from outside
+  EXPECT_NE(bsdf_lobe_name(f, at).find("refracted"), std::string::npos) << bsdf_lobe_name(f, at);
+  for (const char* st : strategies) {
+    const ProbeChiSquare c = probe_chi_square(SamplingPlan::make(Strategy::parse(st), f), at, 20000, 17, 16, 32, 1e-3);
+    std::printf("[probe] frosted sphere %s: p %.3g, %.3f of the expected mass below the surface\n", st,
+                c.result.p_value, share_below(c));
+    EXPECT_TRUE(c.passed) << st << ": p " << c.result.p_value;
+    if (std::string(st) == "bsdf") {
+      EXPECT_GT(share_below(c), 0.5);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pdflab
