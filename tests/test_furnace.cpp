@@ -358,8 +358,8 @@ TEST(RoughDielectricFurnace, EnergyAtMostOneAndSmoothLimit) {
           const float u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
           float s, c;
           sincos_2pi(u2, s, c);
-          const Vec3 wi = leaf::rough_dielectric_sample(wo, alpha, eta, u1, s, c, u3);
-          const float pdf = leaf::rough_dielectric_pdf(wo, wi, alpha, eta);
+          float pdf;
+          const Vec3 wi = leaf::rough_dielectric_sample(wo, alpha, eta, u1, s, c, u3, pdf);
           ASSERT_TRUE(pdf > 0.0f && std::isfinite(pdf)) << "eta " << eta << " alpha " << alpha << " view " << view;
           const double w = leaf::rough_dielectric_value(wo, wi, alpha, eta) / pdf;
           sum += w;
