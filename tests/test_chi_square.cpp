@@ -824,6 +824,20 @@ TEST(EnvironmentMap, TexelsAreChosenInProportionToTheirLight) {
   EXPECT_GT(half->pdf(Vec3(0.0f, 0.0f, -1.0f)), 0.0f) << "phi = 3 pi / 2: lit";
 }
 
+// The environment map's sampler reaches its whole support: from u1 = 0 the
+// zenith itself, from the largest u1 the nadir to within a float step of the
+// last row's share, on a constant map whose every texel is lit.
+TEST(EnvironmentMap, ReachesBothPoles) {
+  const Environment map(std::vector<float>(8 * 4 * 3, 1.0f), 8, 4, 1.0f, 0.0f);
+  for (const float u2 : {0.0f, 0.5f, kLargestUniform}) {
+    const Environment::Sample top = map.sample(0.0f, u2), bottom = map.sample(kLargestUniform, u2);
+    EXPECT_EQ(top.direction.y, 1.0f) << u2;
+    EXPECT_LT(bottom.direction.y, -1.0f + 1e-6f) << u2;
+    EXPECT_GT(top.pdf, 0.0f);
+    EXPECT_GT(bottom.pdf, 0.0f);
+  }
+}
+
 // The harness sees the Jacobian: the same samples judged against a density
 // that forgets sin theta (every texel taken as 4 pi / (W H) sr) are rejected.
 TEST(EnvironmentMap, HarnessRejectsADensityWithoutTheJacobian) {
