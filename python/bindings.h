@@ -42,6 +42,8 @@ struct SceneHandle {
   static std::shared_ptr<SceneHandle> from_text(const std::string& text, const std::string& origin);
   // Sets each key of `changes` in the document's "camera" and loads it again.
   void set_camera(const nlohmann::json& changes);
+  // Loads the edited document `doc` into `scene` and returns its text.
+  std::string reload(nlohmann::json doc);
   // A file holding this scene for the commands that read one (sweep): the
   // file it came from while unchanged, else the document in `folder`.
   std::string file_for_commands(const std::string& folder) const;

@@ -56,6 +56,20 @@ void set_camera_key(CameraView& c, const char* key, const py::object& value) {
 
 }  // namespace
 
+// The document as edited and loaded again: an environment map's relative path
+// made absolute (it started from the file's folder, and an edited document is
+// written elsewhere for the commands: file_for_commands).
+std::string SceneHandle::reload(nlohmann::json doc) {
+  if (from_file && doc.contains("environment") && doc["environment"].is_object() &&
+      doc["environment"].contains("file") && doc["environment"]["file"].is_string()) {
+    const fs::path file = doc["environment"]["file"].get<std::string>();
+    if (file.is_relative()) doc["environment"]["file"] = fs::absolute(fs::path(origin).parent_path() / file).string();
+  }
+  std::string edited_text = doc.dump(2);
+  scene = std::make_shared<const Scene>(load_scene_text(edited_text, origin));
+  return edited_text;
+}
+
 std::shared_ptr<SceneHandle> SceneHandle::load(const std::string& path) {
   auto h = std::make_shared<SceneHandle>();
   h->scene = std::make_shared<const Scene>(load_scene_file(path));  // the command line's checks and messages
@@ -81,9 +95,7 @@ void SceneHandle::set_camera(const nlohmann::json& changes) {
       throw InputError("camera: unknown key '" + it.key() + "' (lookfrom, lookat, vup, vfov, width, height)");
     doc["camera"][it.key()] = it.value();
   }
-  std::string edited_text = doc.dump(2);
-  scene = std::make_shared<const Scene>(load_scene_text(edited_text, origin));
-  text = std::move(edited_text);
+  text = reload(std::move(doc));
   edited = true;
 }
 
@@ -169,9 +181,7 @@ messages (ValueError).)")
           [](SceneHandle& s, int depth) {
             nlohmann::json doc = nlohmann::json::parse(s.text);
             doc["camera"]["max_depth"] = depth;
-            std::string edited_text = doc.dump(2);
-            s.scene = std::make_shared<const Scene>(load_scene_text(edited_text, s.origin));
-            s.text = std::move(edited_text);
+            s.text = s.reload(std::move(doc));
             s.edited = true;
           })
       .def_property(

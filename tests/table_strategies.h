@@ -19,6 +19,11 @@ struct TableStrategy {
   // statistical suites can compare within standard errors.
   bool unbiased;
   bool aims;  // it draws targets (the techniques that draw one: light, light-sa, ...)
+  // It draws from the scene's environment map (`environment`): in a scene
+  // without one it has no weight, and a mixture with cosine is cosine again,
+  // so the suites whose scenes have no map leave it out and test it on their
+  // own scenes with a map (test_analytic's EnvironmentFloor, test_convergence's SunAndSky).
+  bool needs_environment;
 };
 
 // Each technique alone, at its parameter's default and, where the technique is
@@ -31,7 +36,7 @@ inline std::vector<TableStrategy> table_strategies() {
     const Strategy s = Strategy::parse(text);
     const bool alone = text.rfind("mix:", 0) != 0;
     const bool tame = !alone || technique_info(t).heavy_tail_alone(p).empty();
-    out.push_back({text, t, s.is_unbiased() && tame, technique_info(t).draws_target});
+    out.push_back({text, t, s.is_unbiased() && tame, technique_info(t).draws_target, t == Technique::EnvironmentMap});
   };
   for (int i = 0; i < kTechniqueCount; ++i) {
     const auto t = static_cast<Technique>(i);

@@ -17,6 +17,7 @@
 // nearly in the light's plane, and a light beside one 1e9 times as bright
 // that faces away (the light choice by what a point receives).
 #include "renderer/integrator/integrator.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene_loader.h"
 
 #include "tests/render_support.h"
@@ -24,6 +25,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -315,6 +317,7 @@ std::vector<Param> cases() {
     const Scene scene = load_scene_text(scene_json(probe), "probe.json");
     for (const testing::TableStrategy& t : testing::table_strategies()) {
       if (t.technique == Technique::SpecularObjects && t.text == "specular-objects") continue;  // no glass or metal here
+      if (t.needs_environment) continue;  // no map here: EnvironmentFloor below
       std::vector<std::string>& into = aims_at_light(t.text, scene) ? light_strategies : blind_strategies;
       if ((&into == &blind_strategies && !t.unbiased) || std::find(into.begin(), into.end(), t.text) != into.end()) continue;
       into.push_back(t.text);
@@ -403,6 +406,65 @@ std::vector<Param> cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, Analytic, ::testing::ValuesIn(cases()), param_name);
+
+// ---- A floor under a constant environment ---------------------------------
+// A floor of albedo a under an environment of radiance 1 from every direction
+// (and nothing else) reflects exactly a: its irradiance is pi, and it sends
+// a / pi of it towards the camera. Every strategy that can see the
+// environment converges to a, cosine sample by sample (its weight is the
+// albedo and the environment is 1).
+
+// The strategies for the floor: every unbiased one of the table that uses
+// the environment or has none to aim at (a mixture with light leaves it
+// cosine), nee-mis with the environment as its only light.
+std::vector<std::string> environment_floor_strategies() {
+  std::vector<std::string> out = {"nee-mis", "nee-mis:balance", "nee-mis+mix:cosine=0.5,environment=0.5",
+                                  "environment", "mix:uniform-sphere=0.5,environment=0.5"};
+  for (const testing::TableStrategy& t : testing::table_strategies())
+    if (t.unbiased && !t.aims && std::find(out.begin(), out.end(), t.text) == out.end()) out.push_back(t.text);
+  return out;
+}
+
+std::shared_ptr<const Scene> environment_floor(const Vec3& albedo) {
+  char text[1024];
+  std::snprintf(text, sizeof text, R"({
+    "camera": { "width": 8, "height": 8, "vfov": 40, "lookfrom": [0, 1, 0], "lookat": [0, 0, 0], "vup": [0, 0, 1] },
+    "materials": { "floor": { "type": "lambertian", "albedo": [%.9g, %.9g, %.9g] } },
+    "objects": [ { "type": "quad", "q": [-5000, 0, -5000], "u": [0, 0, 10000], "v": [10000, 0, 0], "material": "floor" } ]
+  })", static_cast<double>(albedo.x), static_cast<double>(albedo.y), static_cast<double>(albedo.z));
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "environment_floor.json"));
+  scene->environment = std::make_shared<Environment>(std::vector<float>(16 * 8 * 3, 1.0f), 16, 8, 1.0f, 0.0f);
+  return scene;
+}
+
+class EnvironmentFloor : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EnvironmentFloor, ReflectsExactlyItsAlbedo) {
+  const Vec3 albedo(0.3f, 0.6f, 0.9f);
+  const std::shared_ptr<const Scene> scene = environment_floor(albedo);
+  const testing::Rendered r = testing::render_to_completion(scene, GetParam(), 1024, 29, 2, std::chrono::seconds(300));
+  double sum[3] = {}, var[3] = {};
+  const std::size_t n = r.film.pixel_count();
+  for (std::size_t i = 0; i < n; ++i) {
+    double m[3], v[3];
+    r.film.mean(i, m);
+    r.film.variance_of_mean(i, v);
+    for (int c = 0; c < 3; ++c) sum[c] += m[c] / static_cast<double>(n), var[c] += v[c] / static_cast<double>(n * n);
+    if (GetParam() == "cosine") {
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], albedo[c], 1e-6) << "pixel " << i << ": cosine's every sample is a";
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double a = albedo[c], se = std::sqrt(var[c]);
+    EXPECT_LT(se / a, 0.01) << "too few samples for a meaningful comparison";
+    EXPECT_LT(std::fabs(sum[c] - a), 4.0 * se + 1e-6 * a)
+        << "channel " << c << ": estimate " << sum[c] << ", exact " << a << " (z " << (sum[c] - a) / se << ")";
+  }
+  EXPECT_EQ(r.stats.dropped.total(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Strategies, EnvironmentFloor, ::testing::ValuesIn(environment_floor_strategies()),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return testing::test_name(p.param); });
 
 }  // namespace
 }  // namespace pdflab

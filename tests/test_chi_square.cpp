@@ -8,6 +8,7 @@
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/sampling/techniques.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene.h"
 #include "renderer/scene/scene_loader.h"
 
@@ -63,7 +64,43 @@ enum class Targets {
   TwoPowers,       // two emitting quads overhead, one 40x the other's power
   TwoLightsScene,  // assets/scenes/two_lights.json: a tiny bright light and a wide dim one
   GlossyScene,     // assets/scenes/glossy_metal.json: a metal box (six quads) and a metal sphere
+  // No targets; environment maps other than the sky every other scene has:
+  SubTexelSun,     // 64 x 32, a sky of 0.5 and a sun inside one texel holding 90% of the light
+  BlackHalf,       // 32 x 16, black for phi < pi, lit beyond
+  ConstantMap,     // 8 x 4 of radiance 1
 };
+
+// A lat-long map of w x h texels, radiance `at(x, y)`.
+template <class At>
+std::shared_ptr<const Environment> make_map(int w, int h, float rotation, At at) {
+  std::vector<float> rgb;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Vec3 c = at(x, y);
+      rgb.insert(rgb.end(), {c.x, c.y, c.z});
+    }
+  return std::make_shared<Environment>(std::move(rgb), w, h, 1.0f, rotation);
+}
+
+// The map of each scene: a sky brighter towards the horizon with a sun of
+// one texel (turned 30 degrees), or the scene's own.
+std::shared_ptr<const Environment> scene_map(Targets which) {
+  switch (which) {
+    case Targets::SubTexelSun:
+      // 64 x 32 texels of 0.5 sum to 0.5 * 4 pi; one texel 45 degrees from
+      // the zenith, 0.0068 sr at 5000, holds 5.5 times that.
+      return make_map(64, 32, 0.0f, [](int x, int y) { return x == 20 && y == 8 ? Vec3(5000.0f, 4800.0f, 4500.0f) : Vec3(0.5f); });
+    case Targets::BlackHalf:
+      return make_map(32, 16, 0.0f, [](int x, int y) { return x < 16 ? Vec3(0.0f) : Vec3(1.0f + 0.1f * static_cast<float>(y), 1.0f, 0.5f + 0.05f * static_cast<float>(x)); });
+    case Targets::ConstantMap: return make_map(8, 4, 0.0f, [](int, int) { return Vec3(1.0f); });
+    default:
+      return make_map(32, 16, 30.0f, [](int x, int y) {
+        if (x == 9 && y == 5) return Vec3(2000.0f);
+        const float h = static_cast<float>(y);
+        return Vec3(0.2f + 0.05f * h, 0.3f + 0.04f * h, 0.8f);
+      });
+  }
+}
 
 void add_quad_target(Scene& s, const Vec3& q, const Vec3& u, const Vec3& v) {
   s.targets.push_back({Target::Kind::Quad, static_cast<std::uint32_t>(s.quads.size())});
@@ -83,6 +120,7 @@ std::unique_ptr<Scene> make_scene(Targets which) {
     return std::make_unique<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/glossy_metal.json"));
   auto s = std::make_unique<Scene>();
   s->name = "chi-square targets";
+  s->environment = scene_map(which);  // for the environment technique alone; no other technique sees it
   // Metal, so that specular-objects aims at the same objects as light (a
   // material changes no other technique's targets: they are marked).
   Material metal;
@@ -120,7 +158,10 @@ std::unique_ptr<Scene> make_scene(Targets which) {
     }
     case Targets::Book:
     case Targets::TwoLightsScene:
-    case Targets::GlossyScene: break;
+    case Targets::GlossyScene:
+    case Targets::SubTexelSun:
+    case Targets::BlackHalf:
+    case Targets::ConstantMap: break;
   }
   return s;
 }
@@ -229,6 +270,14 @@ const std::vector<ChiCase>& chi_cases() {
       {"nee_emitters_two_powers_close", "nee-mis", Targets::TwoPowers, {0, 0.9f, 0}, {0, 1, 0}, true},
       {"nee_emitters_two_powers_one_flat", "nee-mis", Targets::TwoPowers, {-0.9f, 0.8f, 0}, {0, 1, 0}, true},
       {"nee_emitters_book_close_to_the_light", "nee-mis", Targets::Book, {300, 500, 250}, {0, 1, 0}, true},
+      // The environment map's 2D distribution: a sun inside one texel, a
+      // black half (its pdf zero there), a constant map (uniform over the sphere).
+      {"environment_sub_texel_sun", "environment", Targets::SubTexelSun, {0, 0, 0}, {0, 1, 0}},
+      {"environment_sub_texel_sun_oblique", "environment", Targets::SubTexelSun, {0, 0, 0}, unit(1, 2, 3)},
+      {"environment_sub_texel_sun_mix", "mix:cosine=0.5,environment=0.5", Targets::SubTexelSun, {0, 0, 0}, unit(0, 1, 1)},
+      {"environment_black_half", "environment", Targets::BlackHalf, {0, 0, 0}, {0, 1, 0}},
+      {"environment_black_half_mix", "mix:cosine=0.5,environment=0.5", Targets::BlackHalf, {0, 0, 0}, {0, 0, -1}},
+      {"environment_constant", "environment", Targets::ConstantMap, {0, 0, 0}, unit(-1, 2, 1)},
   };
   return cases;
 }
@@ -732,6 +781,83 @@ TEST(ChiSquareVndf, MixturesWithBsdf) {
       EXPECT_NEAR(o.integral, 1.0, 3e-3) << text << " alpha " << c.alpha;
     }
   }
+}
+
+// ---- The environment map's 2D distribution ---------------------------------
+
+// A constant map is uniform over the sphere: each texel's probability is its
+// solid angle over 4 pi, and its density 1 / (4 pi) everywhere, to float.
+TEST(EnvironmentMap, ConstantMapIsUniformOverTheSphere) {
+  const std::shared_ptr<const Environment> map = scene_map(Targets::ConstantMap);
+  Rng rng(3, 1);
+  for (int i = 0; i < 1000; ++i) {
+    const Environment::Sample s = map->sample(rng.uniform(), rng.uniform());
+    ASSERT_FALSE(s.none);
+    EXPECT_NEAR(length(s.direction), 1.0f, 1e-6f);
+    EXPECT_NEAR(s.pdf, 1.0 / (4.0 * std::numbers::pi), 1e-7);
+    EXPECT_EQ(s.pdf, map->pdf(s.direction)) << i;
+  }
+  EXPECT_NEAR(map->luminance_integral(), 4.0 * std::numbers::pi, 1e-9);
+}
+
+// The marginal and conditional CDFs: a texel is chosen with the share of
+// luminance times solid angle that it holds; a black texel never.
+TEST(EnvironmentMap, TexelsAreChosenInProportionToTheirLight) {
+  const std::shared_ptr<const Environment> sun = scene_map(Targets::SubTexelSun);
+  const double z0 = std::cos(std::numbers::pi * 8 / 32), z1 = std::cos(std::numbers::pi * 9 / 32);
+  const double sun_sr = 2.0 * std::numbers::pi / 64 * (z0 - z1);
+  const double sun_light = luminance(5000.0, 4800.0, 4500.0) * sun_sr;
+  const double expected = sun_light / (sun_light + 0.5 * (4.0 * std::numbers::pi - sun_sr));
+  EXPECT_NEAR(sun->texel_probability(20, 8), expected, 1e-9);
+  EXPECT_GT(expected, 0.8);
+  EXPECT_NEAR(sun->texel_density(20, 8), expected / sun_sr, 1e-3 * expected / sun_sr);
+  const std::shared_ptr<const Environment> half = scene_map(Targets::BlackHalf);
+  Rng rng(4, 1);
+  for (int i = 0; i < 10000; ++i) {
+    const Environment::Sample s = half->sample(rng.uniform(), rng.uniform());
+    int x, y;
+    half->texel_of(s.direction, x, y);
+    ASSERT_GE(x, 16) << "a direction drawn where the map is black";
+    EXPECT_EQ(half->pdf(s.direction), s.pdf);
+  }
+  EXPECT_EQ(half->pdf(Vec3(0.0f, 0.0f, 1.0f)), 0.0f) << "phi = pi / 2: the black half";
+  EXPECT_GT(half->pdf(Vec3(0.0f, 0.0f, -1.0f)), 0.0f) << "phi = 3 pi / 2: lit";
+}
+
+// The environment map's sampler reaches its whole support: from u1 = 0 the
+// zenith itself, from the largest u1 the nadir to within a float step of the
+// last row's share, on a constant map whose every texel is lit.
+TEST(EnvironmentMap, ReachesBothPoles) {
+  const Environment map(std::vector<float>(8 * 4 * 3, 1.0f), 8, 4, 1.0f, 0.0f);
+  for (const float u2 : {0.0f, 0.5f, kLargestUniform}) {
+    const Environment::Sample top = map.sample(0.0f, u2), bottom = map.sample(kLargestUniform, u2);
+    EXPECT_EQ(top.direction.y, 1.0f) << u2;
+    EXPECT_LT(bottom.direction.y, -1.0f + 1e-6f) << u2;
+    EXPECT_GT(top.pdf, 0.0f);
+    EXPECT_GT(bottom.pdf, 0.0f);
+  }
+}
+
+// The harness sees the Jacobian: the same samples judged against a density
+// that forgets sin theta (every texel taken as 4 pi / (W H) sr) are rejected.
+TEST(EnvironmentMap, HarnessRejectsADensityWithoutTheJacobian) {
+  const std::unique_ptr<Scene> scene = make_scene(Targets::ConstantMap);
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("environment"), *scene);
+  const Environment& map = *plan.environment;
+  const Vec3 n(0, 1, 0);
+  const Frame frame(n);
+  auto wrong = [&](const Vec3& d) {
+    int x, y;
+    map.texel_of(d, x, y);
+    return map.texel_probability(x, y) * map.width() * map.height() / (4.0 * std::numbers::pi);
+  };
+  auto sampler = chi_square::plan_sampler(plan, Vec3(0.0f), n, Sampler::OnePath);
+  const std::vector<chi_square::Point> edges = chi_square::plan_edges(plan, Vec3(0.0f), n, frame);
+  const Outcome o = run_chi_square(frame, sampler, wrong, edges, 31, 100'000);
+  EXPECT_FALSE(o.passed(1e-3));
+  EXPECT_LT(o.chi.p_value, 1e-12);
+  auto right = [&](const Vec3& d) { return static_cast<double>(plan.pdf(Vec3(0.0f), n, d)); };
+  EXPECT_TRUE(run_chi_square(frame, sampler, right, edges, 31, 100'000).passed(1e-3));
 }
 
 // ---- The rough dielectric ---------------------------------------------------

@@ -494,13 +494,18 @@ TEST(Extremes, IntersectionIsTheSameWithAndWithoutTheSimdBatch) {
 TEST(Extremes, NoShippedSceneDropsASample) {
   const char* strategies[] = {"cosine", "uniform-hemisphere", "uniform-sphere", "light", "light-sa",
                               "mix:cosine=0.5,light=0.5", "mix:cosine=0.5,light-sa=0.5", "nee-mis",
-                              "nee-mis:balance"};
+                              "nee-mis:balance", "environment", "mix:cosine=0.5,environment=0.5"};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes")) {
     if (entry.path().extension() != ".json") continue;
     ++scenes;
     const auto scene = load(entry.path().filename().string(), 32, 32);
     for (const char* strategy : strategies) {
+      try {
+        (void)SamplingPlan::make(Strategy::parse(strategy), *scene);
+      } catch (const InputError&) {
+        continue;  // light without targets (the sun and sky), environment without a map
+      }
       const Rendered r = render(scene, strategy, 8);
       EXPECT_EQ(r.stats.dropped.total(), 0u) << entry.path().filename() << " with " << strategy;
     }

@@ -88,6 +88,20 @@ double true_relmse(const std::vector<float>& image, const std::vector<float>& tr
   return pdflab::relmse(image, truth);
 }
 
+// The default reference strategy: the book's mixture, and under an environment light
+// nee-mis continued by cosine and the map's sampler (cosine alone would find a
+// small sun only by chance).
+TEST(ReferenceStrategy, FollowsWhatTheSceneHas) {
+  const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
+  using pdflab::default_reference_strategy;
+  EXPECT_EQ(default_reference_strategy(pdflab::load_scene_file(dir + "/cornell_book.json")).to_string(),
+            "mix:cosine=0.5,light=0.5");
+  pdflab::Scene sky = pdflab::load_scene_file(dir + "/sun_sky.json");
+  EXPECT_EQ(default_reference_strategy(sky).to_string(), "nee-mis+mix:cosine=0.5,environment=0.5");
+  sky.environment.reset();  // without its map: the book's mixture, whose light has no target there (cosine)
+  EXPECT_EQ(default_reference_strategy(sky).to_string(), "mix:cosine=0.5,light=0.5");
+}
+
 TEST(CorrectedRelMse, TwoIndependentNoisyRendersShowNoErrorBeyondTheirNoise) {
   // x and r render the same image independently. Corrected for r's noise, the
   // error of x is its own noise, and minus that (the excess: squared bias) ~ 0;

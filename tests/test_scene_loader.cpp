@@ -3,12 +3,19 @@
 // offending JSON path (or line and column for syntax errors).
 #include "renderer/error.h"
 #include "renderer/sampling/leaf.h"
+#include "renderer/film/image_io.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene_loader.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <vector>
 #include <initializer_list>
 #include <numbers>
 #include <string>
@@ -181,6 +188,64 @@ TEST(SceneLoader, MissingFileNamesThePath) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/scene.json"), std::string::npos) << e.what();
   }
+}
+
+// ---- The environment key -------------------------------------------------------
+
+double lum(const Vec3& c) { return luminance(c.x, c.y, c.z); }
+
+// The shipped sky: its path relative to the scene's folder, scale and
+// rotation applied, and the map's texels in the content hash (a reference
+// depends on them, not on the file's name).
+TEST(SceneLoader, EnvironmentLoadsTheShippedSky) {
+  const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
+  const Scene scene = load_scene_file(dir + "/sun_sky.json");
+  ASSERT_TRUE(scene.environment);
+  const Environment& map = *scene.environment;
+  EXPECT_EQ(map.width(), 256);
+  EXPECT_EQ(map.height(), 128);
+  EXPECT_FLOAT_EQ(map.scale(), 0.35f);
+  EXPECT_TRUE(map.sampleable());
+  // The zenith is blue, the ground below the horizon dark, the sun far brighter than both.
+  const Vec3 zenith = map.radiance(Vec3(0.0f, 1.0f, 0.0f)), ground = map.radiance(Vec3(0.0f, -1.0f, 0.0f));
+  EXPECT_GT(zenith.z, zenith.x);
+  EXPECT_LT(lum(ground), lum(zenith));
+  const double el = 35.0 * std::numbers::pi / 180.0, az = 60.0 * std::numbers::pi / 180.0;
+  const Vec3 sun(static_cast<float>(std::cos(el) * std::cos(az)), static_cast<float>(std::sin(el)),
+                 static_cast<float>(std::cos(el) * std::sin(az)));
+  EXPECT_GT(lum(map.radiance(sun)), 100.0 * lum(zenith));
+
+  std::ifstream in(dir + "/sun_sky.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(load_scene_text(text, "copy.json", dir).content_hash, scene.content_hash);
+  const std::string brighter = std::regex_replace(text, std::regex("\"scale\": 0.35"), "\"scale\": 0.5");
+  ASSERT_NE(brighter, text);
+  EXPECT_NE(load_scene_text(brighter, "copy.json", dir).content_hash, scene.content_hash);
+  // Turned by 90 degrees: what was seen at phi is seen at phi + 90.
+  const std::string turned = std::regex_replace(text, std::regex("\"rotation\": 0"), "\"rotation\": 90");
+  const Scene t = load_scene_text(turned, "copy.json", dir);
+  const Vec3 sun_turned(-sun.z, sun.y, sun.x);
+  EXPECT_EQ(lum(t.environment->radiance(sun_turned)), lum(map.radiance(sun)));
+}
+
+// A map with a negative or non-finite texel is refused with the texel's place.
+TEST(SceneLoader, EnvironmentRefusesABadTexel) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "pdflab_env_texel";
+  std::filesystem::create_directories(dir);
+  std::vector<float> rgb(8 * 4 * 3, 1.0f);
+  rgb[(2 * 8 + 5) * 3 + 1] = -1.0f;
+  write_image((dir / "bad.pfm").string(), rgb, 8, 4);
+  json doc = minimal_scene();
+  doc["environment"] = {{"file", "bad.pfm"}};
+  try {
+    (void)load_scene_text(doc.dump(), "scene.json", dir.string());
+    ADD_FAILURE() << "a negative texel was accepted";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("environment.file:"), std::string::npos) << message;
+    EXPECT_NE(message.find("texel (5, 2) is negative or not finite"), std::string::npos) << message;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // ---- Validation errors name the JSON path ------------------------------------
@@ -494,7 +559,7 @@ TEST(SceneValidation, DuplicateKeysAreRefusedWithTheirPath) {
 // a C string once made into the exception); it shows as \x00 with the rest.
 TEST(SceneValidation, ANulInAKeyIsShownNotCut) {
   const std::string message = load_error(R"({"cam\u0000era": 1, "camera": {}})");
-  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, materials, name, objects)"),
+  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, environment, materials, name, objects)"),
             std::string::npos)
       << message;
 }

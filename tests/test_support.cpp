@@ -131,6 +131,7 @@ TEST(Support, EveryHemisphereTechniqueReachesItsPdfSupport) {
     const auto t = static_cast<Technique>(i);
     const TechniqueInfo& info = technique_info(t);
     if (info.draws_target) continue;  // below
+    if (t == Technique::EnvironmentMap) continue;  // the map's support, not the hemisphere's: test_chi_square's EnvironmentMap.ReachesBothPoles
     for (const float p : parameters(info)) {
       const SamplingPlan plan = alone(t, p);
       const double edge = support_edge(plan);

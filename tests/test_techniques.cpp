@@ -7,12 +7,14 @@
 #include "renderer/integrator/packet.h"
 #include "renderer/sampling/mixture.h"
 #include "renderer/sampling/rng.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene_loader.h"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -21,8 +23,17 @@
 namespace pdflab {
 namespace {
 
+// The book's box, with the shipped sky as its environment so that the
+// environment technique has a map to draw from.
 const Scene& book() {
-  static const Scene s = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  static const Scene s = [] {
+    Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+    int w = 0, h = 0;
+    std::vector<float> rgb =
+        read_environment_image(std::string(PDFLAB_SOURCE_DIR) + "/assets/environments/sun_sky.hdr", w, h);
+    scene.environment = std::make_shared<Environment>(std::move(rgb), w, h, 1.0f, 40.0f);
+    return scene;
+  }();
   return s;
 }
 

@@ -8,6 +8,7 @@
 #include "renderer/hash.h"
 #include "renderer/input_file.h"
 #include "renderer/metrics/metrics.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene.h"
 
 #include <nlohmann/json.hpp>
@@ -292,6 +293,8 @@ std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t 
 }
 
 Strategy default_reference_strategy(const Scene& scene) {
+  if (scene.environment && scene.environment->sampleable())
+    return Strategy::parse("nee-mis+mix:cosine=0.5,environment=0.5");
   const Strategy book = Strategy::parse("mix:cosine=0.5,light=0.5");
   try {
     (void)SamplingPlan::make(book, scene);

@@ -106,7 +106,9 @@ std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t 
 
 // The strategy a reference is made with when none is given: the most efficient
 // unbiased one in pdflab's convergence report for the shipped scenes (the
-// book's mixture), or cosine when the scene has no importance target.
+// book's mixture), or cosine when the scene has no importance target; under
+// an environment light nee-mis continued by cosine and the map's sampler (the
+// map is nee-mis's light sample too: docs/environment.md).
 Strategy default_reference_strategy(const Scene& scene);
 
 // The cache -------------------------------------------------------------------

@@ -76,6 +76,8 @@ void SamplingPlan::bind_targets() {
   power_targets = power_target_set(*scene);
   emitters = emitter_set(*scene);
   specular_objects = specular_object_set(*scene);
+  environment = scene->environment && scene->environment->sampleable() ? scene->environment.get() : nullptr;
+  environment_share = environment_light_share(*scene);
 }
 
 // Technique T's constants for parameter p, where it derives any.

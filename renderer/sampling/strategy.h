@@ -8,6 +8,7 @@
 #include "renderer/sampling/target_set.h"
 #include "renderer/sampling/technique_table.h"
 #include "renderer/sampling/techniques.h"
+#include "renderer/scene/environment.h"
 #include "renderer/scene/scene.h"
 
 #include <array>
@@ -167,6 +168,11 @@ struct SamplingPlan {
   TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
   TargetSet emitters;       // `nee-mis`: every emitter, by power
   TargetSet specular_objects;  // `specular-objects`: the glass and metal objects, chosen uniformly
+  // The scene's environment light where it has light (`environment`'s map;
+  // null: none), and the probability that nee-mis's light sample samples it
+  // rather than the area lights (environment_light_share).
+  const Environment* environment = nullptr;
+  float environment_share = 0.0f;
 
   // Throws InputError when the strategy needs targets the scene does not have
   // and no other technique has weight, or when a positive weight is below

@@ -1,9 +1,12 @@
 #include "renderer/sampling/target_set.h"
 
+#include "renderer/scene/environment.h"
+
 #include "renderer/sampling/mixture.h"
 #include "renderer/sampling/techniques.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace pdflab {
@@ -213,6 +216,37 @@ TargetSet emitter_set(const Scene& scene) {
   set.solid_angle = true;
   set.set_probabilities(power_weights(power));
   return set;
+}
+
+float environment_light_share(const Scene& scene) {
+  if (!scene.environment || !scene.environment->sampleable()) return 0.0f;
+  double emitted = 0.0;  // the area lights' power
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  const auto extend = [&](const Vec3& p, double r) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], static_cast<double>(p[c]) - r);
+      hi[c] = std::max(hi[c], static_cast<double>(p[c]) + r);
+    }
+  };
+  for (const Quad& q : scene.quads) {
+    emitted += emitter_power(scene.materials[q.material], q.area);
+    for (const Vec3& p : {q.q, q.q + q.u, q.q + q.v, q.q + q.u + q.v}) extend(p, 0.0);
+  }
+  for (const Sphere& sp : scene.spheres) {
+    const double r = sp.radius;
+    emitted += emitter_power(scene.materials[sp.material], 4.0 * std::numbers::pi * r * r);
+    extend(sp.center, r);
+  }
+  if (!(emitted > 0.0)) return 1.0f;
+  double radius2 = 0.0;
+  for (int c = 0; c < 3; ++c) radius2 += 0.25 * (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  // The power the map sends through the scene: through a disc of the scene's
+  // bounding radius, from every direction, pi R^2 times the map's luminance
+  // integrated over the sphere.
+  const double environment = std::numbers::pi * radius2 * scene.environment->luminance_integral();
+  double share = environment / (environment + emitted);
+  share = std::clamp(share, static_cast<double>(kEnvironmentShareFloor), 1.0 - kEnvironmentShareFloor);
+  return static_cast<float>(std::round(share * 0x1.0p24) * 0x1.0p-24);
 }
 
 }  // namespace pdflab

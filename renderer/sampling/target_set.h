@@ -115,6 +115,19 @@ TargetSet emitter_set(const Scene& scene);
 // which a light sample cannot reach through).
 TargetSet specular_object_set(const Scene& scene);
 
+// nee-mis's light sample in a scene with an environment light: the
+// probability that it samples the environment (its own 2D distribution),
+// else the area lights (emitter_set). 1 without area lights, 0 without an
+// environment that has light; otherwise in proportion to power, the map's
+// taken as what it sends through a disc of the scene's bounding radius
+// (pi R^2 times its luminance integrated over the sphere), and kept within
+// [kEnvironmentShareFloor, 1 - kEnvironmentShareFloor] so that neither light
+// is starved where power misjudges what a point receives (a room lit through
+// a window). A multiple of 2^-24: the top 24 bits of a 32-bit number choose,
+// and the share is exactly the realised probability.
+inline constexpr float kEnvironmentShareFloor = 0.1f;
+float environment_light_share(const Scene& scene);
+
 // How much light an emitter sends out (luminance of emit * area * pi, doubled
 // when two-sided): the weight for choosing it in proportion to its power.
 double emitter_power(const Material& m, double area);

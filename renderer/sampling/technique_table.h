@@ -17,6 +17,7 @@
 #include "renderer/sampling/techniques/specular_objects.inc"
 #include "renderer/sampling/techniques/uniform_cone.inc"
 #include "renderer/sampling/techniques/bsdf.inc"
+#include "renderer/sampling/techniques/environment.inc"
 
 #elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
 #define PDFLAB_TECHNIQUE_TABLE_H
@@ -31,7 +32,8 @@
   X(CosinePower)             \
   X(SpecularObjects)         \
   X(UniformCone)             \
-  X(Bsdf)
+  X(Bsdf)                    \
+  X(EnvironmentMap)
 
 #include <array>
 #include <cstdint>

@@ -4,11 +4,14 @@
 #include "renderer/math.h"
 
 #include <array>
+#include <memory>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace pdflab {
+
+class Environment;  // renderer/scene/environment.h
 
 // Microfacet: a rough surface of GGX / Trowbridge-Reitz normals of roughness
 // `alpha` with height-correlated Smith masking-shadowing: a conductor (the
@@ -141,6 +144,9 @@ struct Scene {
   Camera camera;
   int max_depth = 50;
   Vec3 background{0.0f};
+  // The environment light (scene file's `environment`): the radiance of a ray
+  // that leaves the scene, in place of `background`; null: none.
+  std::shared_ptr<const Environment> environment;
   std::vector<Material> materials;
   std::vector<std::string> material_names;
   std::vector<Quad> quads;

@@ -4,6 +4,7 @@
 #include "renderer/film/film.h"
 #include "renderer/hash.h"
 #include "renderer/input_file.h"
+#include "renderer/scene/environment.h"
 
 #include <nlohmann/json.hpp>
 
@@ -420,6 +421,43 @@ std::string line_and_column(const std::string& text, std::size_t byte) {
 
 namespace {
 
+// `environment`: a lat-long map (docs/environment.md) read from `file`, a path
+// relative to the scene file's folder (`base`), its radiance times `scale`,
+// turned `rotation` degrees about +y.
+std::shared_ptr<const Environment> parse_environment(const Node& node, const std::filesystem::path& base) {
+  node.expect_object();
+  node.allow_only({"file", "scale", "rotation"});
+  const Node file = node.require("file");
+  const std::string name = file.string();
+  if (name.empty()) file.fail("expected a file name, found an empty string");
+  const std::filesystem::path path = std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : base / name;
+  float scale = 1.0f, rotation = 0.0f;
+  if (node.has("scale")) {
+    const Node n = node.child("scale");
+    scale = n.real();
+    if (!(scale >= 0.0f)) n.fail("must be >= 0 (it multiplies the map's radiance)");
+  }
+  if (node.has("rotation")) {
+    const Node n = node.child("rotation");
+    const double degrees = n.number();
+    if (!(std::fabs(degrees) <= 360.0)) n.fail("must be in -360..360 degrees");
+    rotation = static_cast<float>(degrees);
+  }
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+  try {
+    rgb = read_environment_image(path.string(), width, height);
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
+  auto environment = std::make_shared<Environment>(std::move(rgb), width, height, scale, rotation);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (!is_finite(environment->texel(x, y)))
+        node.fail("the map times scale overflows float at texel (" + std::to_string(x) + ", " + std::to_string(y) + ")");
+  return environment;
+}
+
 // The parsed document without what a reference is keyed by separately (size,
 // depth) or what does not change the image (the description), dumped in one
 // canonical form (sorted keys, no spaces): reformatting a file keeps its hash.
@@ -485,7 +523,7 @@ class DuplicateKeys {
   std::string first_;
 };
 
-Scene parse_scene(const std::string& text, const std::string& origin) {
+Scene parse_scene(const std::string& text, const std::string& origin, const std::filesystem::path& base) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(origin + ": the scene is empty (expected a JSON object)");
   json doc;
@@ -518,7 +556,7 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
                      ": the key appears twice in its object (JSON would keep only the last value)");
   Node root(doc, "", origin);
   root.expect_object();
-  root.allow_only({"name", "description", "camera", "materials", "objects"});
+  root.allow_only({"name", "description", "camera", "materials", "objects", "environment"});
 
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : origin;
@@ -542,16 +580,28 @@ Scene parse_scene(const std::string& text, const std::string& origin) {
     parse_object(objects.element(i), i, by_name, scene, placement);
   place_in_rendering_space(root, placement, scene);
 
+  if (root.has("environment")) {
+    if (root.child("camera").has("background"))
+      root.child("environment").fail("camera.background is given too: the environment is the radiance of every ray "
+                                     "that leaves the scene; give one of them");
+    scene.environment = parse_environment(root.child("environment"), base);
+  }
+
   scene.prepare();
   scene.content_hash = content_hash(doc);
+  if (scene.environment) {
+    // The map's texels, not only its file name: a reference depends on them.
+    const std::string both = scene.content_hash + ":" + std::to_string(scene.environment->hash());
+    scene.content_hash = fnv1a_hex(both.data(), both.size());
+  }
   return scene;
 }
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& origin) {
+Scene load_scene_text(const std::string& text, const std::string& origin, const std::string& base) {
   try {
-    return parse_scene(text, origin);
+    return parse_scene(text, origin, base);
   } catch (const InputError& e) {
     throw InputError(printable(e.what()));
   }
@@ -580,7 +630,7 @@ Scene load_scene_file(const std::string& path) {
   const bool failed = std::ferror(in) != 0;
   std::fclose(in);
   if (failed) throw InputError("cannot read scene '" + path + "': read error");
-  return load_scene_text(text, path);
+  return load_scene_text(text, path, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace pdflab

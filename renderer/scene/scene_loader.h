@@ -9,7 +9,9 @@
 namespace pdflab {
 
 Scene load_scene_file(const std::string& path);
-// `origin` names the source in messages (a file name, "<string>").
-Scene load_scene_text(const std::string& text, const std::string& origin);
+// `origin` names the source in messages (a file name, "<string>"); `base` is
+// the folder a relative environment map's path starts from (empty: the
+// working directory).
+Scene load_scene_text(const std::string& text, const std::string& origin, const std::string& base = "");
 
 }  // namespace pdflab
