@@ -26,7 +26,7 @@ namespace pdflab {
 namespace {
 
 const Scene& book() {
-  static const Scene s = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
+  static const Scene s = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/cornell_book.json");
   return s;
 }
 
