@@ -470,6 +470,55 @@ TEST(Extremes, FloatSphereTestStaysWithinItsHitErrorBound) {
   std::printf("float sphere test: worst distance from the sphere %.3f of 64 eps (t + r), %d hits\n", worst, hits);
 }
 
+
+TEST(Extremes, SphereCullNeverClearsARayTheDoubleTestHits) {
+  // Spheres tested in double (small against the scene) from radius 1e-6 to
+  // 1e5, centres up to 1e6 from the origin and ray origins up to 1e4 radii
+  // away: rays aimed within a few float roundings of the silhouette, across
+  // the sphere, away from it and from inside. leaf::sphere_may_be_hit may only
+  // clear a ray the double test does not hit, and it clears most of the rays
+  // aimed away (where it saves the double test).
+  Rng rng(11, 3);
+  int hits = 0, cleared = 0, away = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const float r = std::pow(10.0f, -6.0f + 11.0f * rng.uniform());
+    const float far = std::pow(10.0f, 6.0f * rng.uniform());
+    const Vec3 c = sample_uniform_sphere(rng.uniform(), rng.uniform()).direction * (far * rng.uniform());
+    const float distance = r * std::pow(10.0f, -0.5f + 4.5f * rng.uniform());  // inside too
+    const Vec3 o = c + sample_uniform_sphere(rng.uniform(), rng.uniform()).direction * distance;
+    Sphere s{c, r, 0};
+    s.float_test = false;
+    Vec3 aim;
+    const int kind = i % 4;
+    if (kind == 0) {  // within about 2^-20 of the silhouette, either side
+      aim = c + sample_uniform_sphere(rng.uniform(), rng.uniform()).direction *
+                    (r * (1.0f + std::ldexp(2.0f * rng.uniform() - 1.0f, -20)));
+    } else if (kind == 1) {  // across the sphere
+      aim = c + sample_uniform_sphere(rng.uniform(), rng.uniform()).direction * (r * rng.uniform());
+    } else {  // anywhere
+      aim = o + sample_uniform_sphere(rng.uniform(), rng.uniform()).direction;
+    }
+    if (aim == o) continue;
+    const Vec3 d = normalize(aim - o);
+    bool hit = false;
+    leaf::sphere_hit_distance_in<leaf::Double>(s, o, d, kInf, hit);
+    const bool may = leaf::sphere_may_be_hit(s, o, d);
+    if (hit) {
+      ++hits;
+      ASSERT_TRUE(may) << i << " r " << r << " |f| " << distance << " kind " << kind;
+    }
+    if (kind >= 2 && !hit) {
+      ++away;
+      if (!may) ++cleared;
+    }
+    bool through_cull = false;
+    leaf::sphere_hit_distance(s, o, d, kInf, through_cull);
+    ASSERT_EQ(through_cull, hit) << i;
+  }
+  EXPECT_GT(hits, 50000);
+  EXPECT_GT(cleared, away / 2);
+  std::printf("sphere cull: %d hits, %d of %d rays that miss cleared in float\n", hits, cleared, away);
+}
 TEST(Extremes, IntersectionIsTheSameWithAndWithoutTheSimdBatch) {
   // A scene edited by hand after prepare() falls back to the scalar loop; both must agree.
   Scene prepared = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
