@@ -1,99 +1,8 @@
-// Vectors of eight or sixteen lanes are passed between the kernel's inline
-// helpers only (and rng.h's, always inlined): the note that their ABI differs
-// without AVX does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
-#include "renderer/integrator/packet.h"
-
-#include <array>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <numbers>
-#include <string>
-#include <string_view>
-#include <type_traits>
-#include <vector>
-
-#if defined(__x86_64__) || defined(__i386__)
-// GCC 12 warns inside its own AVX-512 header, where _mm512_undefined_ps and
-// its kin read a deliberately undefined register (GCC bug 105593): the
-// warnings (maybe and definitely uninitialized, by how the call is inlined)
-// are about the header's lines, so they are turned off for them only.
-#pragma GCC diagnostic push
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#endif
-#include <immintrin.h>
-#pragma GCC diagnostic pop
-#define PDFLAB_PACKET_X86 1
-#else
-#define PDFLAB_PACKET_X86 0
-#endif
-
-// With GCC on x86-64 the kernel is compiled twice more, for AVX2 (eight lanes
-// in one register, against four with SSE2) and for AVX-512 (sixteen), and the
-// widest the machine has is chosen at run time, so a portable build still uses
-// the machine it runs on. The arithmetic is the same
-// IEEE operations in the same order either way (the build turns off FMA
-// contraction), so all give the same bits. Helpers from other headers are compiled for the baseline and may
-// be inlined into the wider code, never the other way round.
-#if PDFLAB_PACKET_X86 && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
-#define PDFLAB_PACKET_DISPATCH 1
-#else
-#define PDFLAB_PACKET_DISPATCH 0
-#endif
-
-#include "renderer/sampling/mixture.h"  // the one-path tracer's leaf math
-#include "renderer/sampling/sobol.h"  // its templates run on the kernel's vectors too
-
-#include <bit>
-#include <glm/gtc/type_ptr.hpp>
+// Which of the packet kernels (packet_kernels.h) runs: the widest this
+// machine has, or the one PDFLAB_ISA names.
+#include "renderer/integrator/packet_kernels.h"
 
 namespace pdflab {
-
-#define PDFLAB_PACKET_ONE 0
-#define PDFLAB_PACKET_AVX2 0
-#define PDFLAB_PACKET_AVX512 0
-namespace packet_generic {
-#include "renderer/integrator/kernel.inc"
-}  // namespace packet_generic
-
-// One lane: the one-path tracer (trace_path), the same code as every packet.
-#undef PDFLAB_PACKET_ONE
-#define PDFLAB_PACKET_ONE 1
-namespace packet_one {
-#include "renderer/integrator/kernel.inc"
-}  // namespace packet_one
-#undef PDFLAB_PACKET_ONE
-#define PDFLAB_PACKET_ONE 0
-
-#if PDFLAB_PACKET_DISPATCH
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#undef PDFLAB_PACKET_AVX2
-#define PDFLAB_PACKET_AVX2 1
-namespace packet_avx2 {
-#include "renderer/integrator/kernel.inc"
-}  // namespace packet_avx2
-#pragma GCC pop_options
-
-// AVX-512 Foundation and DQ (the 64-bit multiply of the random streams).
-#pragma GCC push_options
-#pragma GCC target("avx2,avx512f,avx512dq")
-#undef PDFLAB_PACKET_AVX2
-#define PDFLAB_PACKET_AVX2 0
-#undef PDFLAB_PACKET_AVX512
-#define PDFLAB_PACKET_AVX512 1
-namespace packet_avx512 {
-#include "renderer/integrator/kernel.inc"
-}  // namespace packet_avx512
-#pragma GCC pop_options
-#endif
-#undef PDFLAB_PACKET_ONE
-#undef PDFLAB_PACKET_AVX2
-#undef PDFLAB_PACKET_AVX512
 
 namespace {
 // Whether this build has the kernel for `isa` and this machine (with its
@@ -171,12 +80,12 @@ std::string_view packet_isa_name(PacketIsa isa) {
 
 int packet_lanes(PacketIsa isa) {
 #if PDFLAB_PACKET_DISPATCH
-  if (isa == PacketIsa::Avx512) return packet_avx512::W;
-  if (isa == PacketIsa::Avx2) return packet_avx2::W;
+  if (isa == PacketIsa::Avx512) return packet_avx512::lane_count();
+  if (isa == PacketIsa::Avx2) return packet_avx2::lane_count();
 #else
   (void)isa;
 #endif
-  return packet_generic::W;
+  return packet_generic::lane_count();
 }
 
 // Calls the kernel compiled for `isa` (AVX2 and AVX-512 only where the build dispatches).

@@ -1,7 +1,7 @@
 #pragma once
 // The leaf math (leaf_math.inc) for one path at a time: Float is float and a
 // Mask is a bool. The packet tracer compiles the same file for its SIMD lanes
-// (renderer/integrator/packet_kernel.inc); the one-path tracer, the probe and
+// (renderer/integrator/kernel.inc); the one-path tracer, the probe and
 // the tests call these.
 #include "renderer/math.h"
 #include "renderer/scene/scene.h"
