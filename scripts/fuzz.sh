@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 seconds=${PDFLAB_FUZZ_SECONDS:-60}
 jobs=${PDFLAB_JOBS:-$(nproc)}
 
-cmake --preset fuzz >/dev/null
+bash scripts/configure.sh fuzz >/dev/null
 cmake --build --preset fuzz -j"$jobs" >/dev/null
 
 crashes=build/fuzz/crashes

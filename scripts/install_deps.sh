@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config ninja-build   # ninja: scripts/configure.sh
   libglfw3-dev libimgui-dev libglm-dev libstb-dev python3-glad python3-jinja2
   nlohmann-json3-dev libcli11-dev libpcg-cpp-dev libmuparser-dev   # libmuparser: the 1D lab's typed f(x)
   libopenexr-dev openexr zlib1g-dev   # EXR output (openexr: exrheader, which a test reads our files with); film checksums

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
-cmake --preset release >/dev/null
+bash scripts/configure.sh release >/dev/null
 cmake --build --preset release -j"$(nproc)" --target pdflab_python
 export PYTHONPATH="$PWD/build/release/python${PYTHONPATH:+:$PYTHONPATH}"
 args=(--notebook-dir=docs/notebooks)

@@ -4,6 +4,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
-cmake --preset release >/dev/null
+bash scripts/configure.sh release >/dev/null
 cmake --build --preset release -j"$(nproc)" --target pdflab
 exec build/release/app/pdflab "$@"

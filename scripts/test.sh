@@ -17,7 +17,7 @@ phase_done() {
   phase_start=$SECONDS
 }
 
-cmake --preset release >/dev/null
+bash scripts/configure.sh release >/dev/null
 cmake --build --preset release -j"$jobs"
 ctest --preset release -j"$jobs" --timeout 600 -LE gui
 # The GUI tests drive a real (virtual) X server with xdotool, whose start-up and
@@ -33,7 +33,7 @@ phase_done "Release build and suite"
 export ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
-cmake --preset asan >/dev/null
+bash scripts/configure.sh asan >/dev/null
 cmake --build --preset asan -j"$jobs"
 ctest --preset asan -j"$jobs" --timeout 900 -LE 'slow|nosan'
 phase_done "ASan+UBSan build and suite (without slow tests)"
@@ -42,7 +42,7 @@ phase_done "ASan+UBSan build and suite (without slow tests)"
 # kernels' address randomisation collides with; run without it where we can.
 no_aslr=()
 if setarch "$(uname -m)" -R true 2>/dev/null; then no_aslr=(setarch "$(uname -m)" -R); fi
-cmake --preset tsan >/dev/null
+bash scripts/configure.sh tsan >/dev/null
 cmake --build --preset tsan -j"$jobs" --target test_session_soak session_viewer_test test_reference_build
 "${no_aslr[@]}" ctest --preset tsan -j"$jobs" --timeout 900 -L session
 phase_done "TSan build and session tests"
