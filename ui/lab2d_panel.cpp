@@ -212,15 +212,25 @@ void histogram_view(const Lab2dState& s, float width) {
   const float gap = ImGui::GetStyle().ItemSpacing.x;
   const ImVec2 cell((width - gap) * 0.5f, (width - gap) * 0.25f);
   // Two by two: the histogram beside N times the pdf, the residuals beside the verdict.
+  // Titles wrap at the cell's width (a large UI scale), each pair kept level.
+  const float top_h = std::max(ImGui::CalcTextSize("samples (32 x 16 cells)", nullptr, false, cell.x).y,
+                               ImGui::CalcTextSize("E = N x pdf over a cell", nullptr, false, cell.x).y);
+  const auto title = [&](const char* text, float h) {
+    const float y = ImGui::GetCursorPosY();
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + cell.x);
+    ImGui::TextUnformatted(text);
+    ImGui::PopTextWrapPos();
+    ImGui::SetCursorPosY(y + h + ImGui::GetStyle().ItemSpacing.y);
+  };
   ImGui::BeginGroup();
-  ImGui::TextUnformatted("samples (32 x 16 cells)");
+  title("samples (32 x 16 cells)", top_h);
   heat_map("##observed", observed, cell, lo, hi, false);
-  ImGui::TextUnformatted("(O - E) / sqrt(E)");
+  title("(O - E) / sqrt(E)", ImGui::GetTextLineHeight());
   heat_map("##residual", z, cell, 0.0, 4.0, true);
   ImGui::EndGroup();
   ImGui::SameLine();
   ImGui::BeginGroup();
-  ImGui::TextUnformatted("E = N x pdf over a cell");
+  title("E = N x pdf over a cell", top_h);
   heat_map("##expected", expected, cell, lo, hi, false);
   ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + cell.x);
   const stats::ChiSquareResult r = lab.chi_square();
@@ -343,6 +353,14 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
   s.step();
   lab::Lab2d& lab = *s.lab;
 
+  // The controls wrap onto the next row rather than run past the window's edge.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const auto labelled = [&](float item, const char* label) { return item + style.ItemInnerSpacing.x + ImGui::CalcTextSize(label).x; };
+  const auto button_width = [&](const char* label) { return ImGui::CalcTextSize(label).x + style.FramePadding.x * 2.0f; };
+  const auto same_line_if_fits = [&](float width) {
+    ImGui::SameLine();
+    if (ImGui::GetContentRegionAvail().x < width) ImGui::NewLine();
+  };
   ImGui::SetNextItemWidth(font * 13.0f);
   if (ImGui::BeginCombo("map", std::string(lab2d_source_name(s.source)).c_str())) {
     for (int i = 0; i < static_cast<int>(Lab2dState::Source::Count); ++i) {
@@ -352,22 +370,23 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
     }
     ImGui::EndCombo();
   }
-  ImGui::SameLine();
+  same_line_if_fits(labelled(font * 6.0f, "resolution"));
   ImGui::SetNextItemWidth(font * 6.0f);
   if (ImGui::BeginCombo("resolution", size_text(lab.map().width, lab.map().height).c_str())) {
     for (int l = 0; l < lab.levels(); ++l)
       if (ImGui::Selectable(size_text(lab.map(l).width, lab.map(l).height).c_str(), l == lab.level())) s.set_level(l);
     ImGui::EndCombo();
   }
-  ImGui::SameLine();
+  same_line_if_fits(labelled(font * 8.0f, "row"));
   int row = s.picked_row();
   ImGui::SetNextItemWidth(font * 8.0f);
   if (ImGui::SliderInt("row", &row, 0, lab.map().height - 1)) s.row = row;
-  ImGui::SameLine();
-  if (ImGui::Button(s.running ? "Pause" : "Run")) s.running = !s.running;
-  ImGui::SameLine();
+  const char* run_label = s.running ? "Pause" : "Run";
+  same_line_if_fits(button_width(run_label));
+  if (ImGui::Button(run_label)) s.running = !s.running;
+  same_line_if_fits(button_width("Reset"));
   if (ImGui::Button("Reset")) lab.reset();
-  ImGui::SameLine();
+  same_line_if_fits(labelled(font * 6.0f, "samples/frame"));
   ImGui::SetNextItemWidth(font * 6.0f);
   ImGui::SliderInt("samples/frame", &s.samples_per_frame, 1, 20000, "%d", ImGuiSliderFlags_Logarithmic);
   if (!s.error.empty()) ImGui::TextColored(kRed, "%s", s.error.c_str());
@@ -379,7 +398,9 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
   const float avail = ImGui::GetContentRegionAvail().x;
   const float map_width = (avail - gap) * 0.5f;
   ImGui::BeginGroup();
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + map_width);
   ImGui::Text("the map, %s, and the latest %zu samples", size_text(lab.map().width, lab.map().height).c_str(), lab.dots().size());
+  ImGui::PopTextWrapPos();
   map_view(s, ImVec2(map_width, map_width * 0.5f));
   ImGui::EndGroup();
   ImGui::SameLine();
@@ -387,16 +408,15 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
 
   const float rest = ImGui::GetContentRegionAvail().y;
   // The table below: two lines of text, and a header and six rows.
-  const ImGuiStyle& style = ImGui::GetStyle();
   const float table_height = ImGui::GetTextLineHeightWithSpacing() * 2.0f +
                              7.0f * (font + 2.0f * style.CellPadding.y + 1.0f) + 2.0f * style.ItemSpacing.y;
   const ImVec2 plot((avail - gap) * 0.5f, std::max(font * 7.0f, rest - table_height));
   const int picked = s.picked_row();
   const double theta0 = 180.0 * picked / lab.map().height, theta1 = 180.0 * (picked + 1) / lab.map().height;
-  cdf_plot("marginal over rows: P(row) and its CDF", lab.marginal_cdf(), 180.0, "theta (degrees from the zenith)", plot, picked);
+  cdf_plot("marginal: P(row) and its CDF", lab.marginal_cdf(), 180.0, "theta (degrees from the zenith)", plot, picked);
   ImGui::SameLine();
   char title[96];
-  std::snprintf(title, sizeof title, "row %d (theta %.1f to %.1f): P(column | row), CDF", picked, theta0, theta1);
+  std::snprintf(title, sizeof title, "row %d (theta %.1f-%.1f): P(column | row)", picked, theta0, theta1);
   cdf_plot(title, lab.conditional_cdf(picked), 360.0, "phi (degrees)", plot, -1);
   resolution_table(s);
   ImGui::End();
