@@ -205,6 +205,14 @@ TEST(Lab2d, TheScenesMapIsSeenScaledInItsOwnFrame) {
     for (int x = 0; x < 16; ++x) ASSERT_DOUBLE_EQ(lab.environment().texel_probability(x, y), scene.texel_probability(x, y));
 }
 
+TEST(Lab2d, AMapWithoutLightDrawsNothing) {
+  Lab2d lab(LabMap{"black", LatLongMap{std::vector<float>(16 * 8 * 3, 0.0f), 16, 8}, std::nullopt});
+  lab.draw(1000);
+  EXPECT_EQ(lab.count(), 0u);
+  EXPECT_EQ(lab.marginal_cdf().back(), 1.0);  // uniform rows, as the sampler's CDFs are
+  EXPECT_EQ(lab.resolution_study()[0].peak_pdf, 0.0);
+}
+
 TEST(Lab2d, AMissingSunSkyFileIsNamed) {
   try {
     (void)make_test_map(TestMap::SunSky, "/nonexistent/sky.hdr");

@@ -234,7 +234,9 @@ void histogram_view(const Lab2dState& s, float width) {
   heat_map("##expected", expected, cell, lo, hi, false);
   ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + cell.x);
   const stats::ChiSquareResult r = lab.chi_square();
-  if (lab.count() < 1000) {
+  if (!lab.environment().sampleable()) {
+    ImGui::TextColored(kRed, "the map has no light: nothing to sample");
+  } else if (lab.count() < 1000) {
     ImGui::TextColored(kDim, "chi-square: collecting samples...");
   } else {
     const ImVec4 verdict = r.p_value > 1e-3 && r.zero_cell_hits == 0 ? kGreen : kRed;
@@ -278,7 +280,7 @@ void cdf_plot(const char* title, const std::vector<double>& cdf, double degrees,
 
 void resolution_table(Lab2dState& s) {
   const lab::Lab2d& lab = *s.lab;
-  const std::vector<lab::Lab2d::LevelFigures> study = lab.resolution_study();
+  const std::vector<lab::Lab2d::LevelFigures>& study = lab.resolution_study();
   const bool sun = lab.sun().has_value();
   if (sun)
     ImGui::TextWrapped("The sun: %.3g sr; a sampler exact to the radiance puts %.4g /sr on it (its luminance over the "

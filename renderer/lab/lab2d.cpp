@@ -139,6 +139,7 @@ Lab2d::Lab2d(LabMap m) : name_(std::move(m.name)), sun_(m.sun) {
     if (!halve) break;
     at = std::move(next);
   }
+  study_ = study();
   set_level(0);
 }
 
@@ -241,7 +242,7 @@ double Lab2d::sun_exact_density() const {
   return integral > 0.0 ? sun_->luminance / integral : 0.0;
 }
 
-std::vector<Lab2d::LevelFigures> Lab2d::resolution_study() const {
+std::vector<Lab2d::LevelFigures> Lab2d::study() const {
   std::vector<LevelFigures> out;
   for (const Level& l : levels_) {
     const Environment& env = *l.environment;

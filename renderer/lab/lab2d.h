@@ -121,7 +121,8 @@ class Lab2d {
     double sun_pdf = 0.0;           // the density at the sun's centre (0 without a sun)
     double sun_texel_solid_angle = 0.0;
   };
-  std::vector<LevelFigures> resolution_study() const;
+  // Worked out once, when the lab is made (a large map's levels are many texels).
+  const std::vector<LevelFigures>& resolution_study() const { return study_; }
   // The density a sampler exact to the radiance puts on the sun's disc:
   // its luminance over the map's luminance integral (0 without a sun).
   double sun_exact_density() const;
@@ -132,6 +133,7 @@ class Lab2d {
     std::shared_ptr<const Environment> environment;
   };
   void compute_cells();
+  std::vector<LevelFigures> study() const;
 
   std::string name_;
   std::optional<Sun> sun_;
@@ -142,6 +144,7 @@ class Lab2d {
   std::size_t next_dot_ = 0;
   std::vector<std::uint64_t> histogram_;
   std::vector<double> cell_probability_;
+  std::vector<LevelFigures> study_;
 };
 
 }  // namespace pdflab::lab
