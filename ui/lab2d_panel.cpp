@@ -137,7 +137,10 @@ void map_view(Lab2dState& s, ImVec2 size) {
   const ImVec2 p1(p0.x + size.x, p0.y + size.y);
   ImGui::InvisibleButton("##lab2d_map", size);
   layout::item("lab2d.map");
-  if (ImGui::IsItemActive() && ImGui::IsMouseDown(0))
+  // The press picks the row where it landed (its frame may already see the
+  // release), a drag the row under the pointer.
+  if (ImGui::IsItemActivated()) s.row = lab2d_row_at((ImGui::GetIO().MouseClickedPos[0].y - p0.y) / size.y, m.height);
+  else if (ImGui::IsItemActive() && ImGui::IsMouseDown(0))
     s.row = lab2d_row_at((ImGui::GetIO().MousePos.y - p0.y) / size.y, m.height);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Click or drag: the row whose conditional CDF is shown");
   ImDrawList* dl = ImGui::GetWindowDrawList();
@@ -278,6 +281,35 @@ void cdf_plot(const char* title, const std::vector<double>& cdf, double degrees,
   plot.legend({{"CDF", kCdf}, {top_text, kBars}}, true);
 }
 
+// The pdf's peak against the texel count, log-log: slope 1 while the sun
+// fits in a texel, bending under the sun's exact density once it does not.
+void peak_plot(const lab::Lab2d& lab, ImVec2 size) {
+  const std::vector<lab::Lab2d::LevelFigures>& study = lab.resolution_study();
+  std::vector<double> texels, peak, guide;
+  for (const lab::Lab2d::LevelFigures& f : study) {
+    texels.push_back(static_cast<double>(f.width) * f.height);
+    peak.push_back(f.peak_pdf);
+  }
+  if (study.size() < 2 || !(peak.back() > 0.0)) {
+    ImGui::Dummy(size);
+    return;
+  }
+  for (double t : texels) guide.push_back(peak.back() * t / texels.back());
+  const double exact = lab.sun_exact_density();
+  std::vector<double> all = peak;
+  if (exact > 0.0) all.push_back(exact);
+  const draw::Plot plot("pdf peak vs texels", size, {texels.back() * 0.6, texels.front() * 1.6, true},
+                        draw::fit_axis(all, true, 0.1), "texels (log)");
+  plot.line(texels, guide, IM_COL32(170, 170, 170, 150), 1.0f);
+  if (exact > 0.0) plot.hline(exact, kSun);
+  plot.line(texels, peak, kCdf, 2.0f);
+  const ImVec2 at = plot.at(texels[static_cast<std::size_t>(lab.level())], peak[static_cast<std::size_t>(lab.level())]);
+  plot.list()->AddCircleFilled(at, 4.0f, kRow);
+  std::vector<std::pair<std::string, ImU32>> legend = {{"peak", kCdf}, {"~ texels", IM_COL32(170, 170, 170, 150)}};
+  if (exact > 0.0) legend.emplace_back("the sun's exact", kSun);
+  plot.legend(legend, true);
+}
+
 void resolution_table(Lab2dState& s) {
   const lab::Lab2d& lab = *s.lab;
   const std::vector<lab::Lab2d::LevelFigures>& study = lab.resolution_study();
@@ -289,13 +321,14 @@ void resolution_table(Lab2dState& s) {
   else
     ImGui::TextWrapped("No sun known on this map: the figures are the brightest texel's. Each resolution (click one to sample it):");
   const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp;
-  if (!ImGui::BeginTable("##resolutions", sun ? 6 : 4, flags)) return;
-  share_columns(sun ? std::initializer_list<float>{1.0f, 1.3f, 1.1f, 1.2f, 1.2f, 1.1f}
+  // The table on the left, the peak against the texel count on the right.
+  const float table_width = ImGui::GetContentRegionAvail().x * 0.64f;
+  if (!ImGui::BeginTable("##resolutions", sun ? 6 : 4, flags, ImVec2(table_width, 0.0f))) return;
+  share_columns(sun ? std::initializer_list<float>{1.0f, 1.3f, 1.0f, 0.9f, 1.0f, 1.1f}
                     : std::initializer_list<float>{1.0f, 1.3f, 1.2f, 1.2f});
   ImGui::TableNextRow(ImGuiTableRowFlags_Headers);
-  const char* heads_sun[] = {"texels", "texel at the sun (sr)", "sun / texel", "P(that texel)", "pdf peak (1/sr)",
-                             "peak / exact"};
-  const char* heads[] = {"texels", "brightest texel (sr)", "P(that texel)", "pdf peak (1/sr)"};
+  const char* heads_sun[] = {"texels", "sun's texel (sr)", "sun / texel", "P(texel)", "peak (1/sr)", "peak / exact"};
+  const char* heads[] = {"texels", "brightest texel (sr)", "P(texel)", "peak (1/sr)"};
   for (int c = 0; c < (sun ? 6 : 4); ++c) {
     ImGui::TableSetColumnIndex(c);
     ImGui::TextUnformatted(sun ? heads_sun[c] : heads[c]);
@@ -326,6 +359,9 @@ void resolution_table(Lab2dState& s) {
     }
   }
   ImGui::EndTable();
+  const float table_height = ImGui::GetItemRectSize().y;
+  ImGui::SameLine();
+  peak_plot(lab, ImVec2(ImGui::GetContentRegionAvail().x, table_height));
   if (chosen >= 0) s.set_level(chosen);
 }
 

@@ -141,15 +141,21 @@ awk -v p="$(layout_py "d['lab2d']['chi_square_p']")" 'BEGIN { exit !(p > 1e-6) }
 click lab2d.level.64
 await_layout "d['lab2d']['width'] == 64 and d['lab2d']['height'] == 32"
 read -r mx my mw mh <<<"$(item lab2d.map)"
-xdotool mousemove "$((mx + mw / 2))" "$((my + mh * 3 / 8 + 2))" click 1
-xdotool mousemove 2 2
+# click_at X Y: the pointer rests there a moment before the click (a loaded machine's frame sees it arrive).
+click_at() {
+  xdotool mousemove "$1" "$2"
+  sleep 0.15
+  xdotool click 1
+  sleep 0.15
+  xdotool mousemove 2 2
+}
+click_at "$((mx + mw / 2))" "$((my + mh * 3 / 8 + 2))"
 await_layout "d['lab2d']['row'] == 12"
 sleep 0.5
 shot lab2d_row
 changed "$art/lab2d.png" "$art/lab2d_row.png"
 # Back up to the sun's row (9 of 32): its conditional CDF jumps at the sun's column.
-xdotool mousemove "$((mx + mw / 2))" "$((my + mh * 19 / 64))" click 1
-xdotool mousemove 2 2
+click_at "$((mx + mw / 2))" "$((my + mh * 19 / 64))"
 await_layout "d['lab2d']['row'] == 9"
 sleep "$settle"
 shot lab2d_sun
