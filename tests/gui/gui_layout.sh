@@ -110,7 +110,7 @@ for config in "1280x720 1.5" "1280x720 2" "1920x1080 1"; do
   echo "-- the 2D lab fits the window"
   send_key d
   await_layout "any(w['name'].startswith('2D lab') for w in d['windows'])"
-  sleep 1
+  sleep 0.3
   [ "$(layout_py "all(x['x'] >= 0 and x['y'] >= 0 and x['x'] + x['w'] <= $w and x['y'] + x['h'] <= $h for x in d['windows'] if x['name'].startswith('2D lab'))")" = True ] ||
     fail "the 2D lab does not fit the window"
   shot "${name}_lab2d"

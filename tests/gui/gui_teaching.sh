@@ -17,8 +17,8 @@ shift
 pdflab=$1 scene=$2 art=$3 docs=${4:-}
 rm -rf "$art"
 mkdir -p "$art"
-settle=2
-[ -n "$docs" ] && settle=12
+settle=2 lab2d_settle=0.5
+[ -n "$docs" ] && settle=12 lab2d_settle=12
 
 # not_blank FILE: some brightness and some structure.
 not_blank() {
@@ -157,7 +157,7 @@ changed "$art/lab2d.png" "$art/lab2d_row.png"
 # Back up to the sun's row (9 of 32): its conditional CDF jumps at the sun's column.
 click_at "$((mx + mw / 2))" "$((my + mh * 19 / 64))"
 await_layout "d['lab2d']['row'] == 9"
-sleep "$settle"
+sleep "$lab2d_settle"
 shot lab2d_sun
 changed "$art/lab2d_row.png" "$art/lab2d_sun.png"
 [ -n "$docs" ] && cp "$art/lab2d_sun.png" "$docs/lab2d.png"
