@@ -256,15 +256,22 @@ void histogram_view(const Lab2dState& s, float width) {
 }
 
 // A CDF as a line and its pmf as bars (scaled to the plot), over `degrees`.
+// With `log_bars` the bars span six decades below the largest (a sun's row
+// otherwise flattens the sky's to nothing; in the sun's row a sky texel has
+// a few 1e-5 of the sun's texel).
 void cdf_plot(const char* title, const std::vector<double>& cdf, double degrees, const char* x_label, ImVec2 size,
-              int mark) {
+              int mark, bool log_bars) {
   const auto n = static_cast<int>(cdf.size()) - 1;
   std::vector<double> xs(cdf.size()), bars(static_cast<std::size_t>(n));
   for (int i = 0; i <= n; ++i) xs[static_cast<std::size_t>(i)] = degrees * i / n;
   double top = 0.0;
   for (int i = 0; i < n; ++i) top = std::max(top, cdf[static_cast<std::size_t>(i) + 1] - cdf[static_cast<std::size_t>(i)]);
-  for (int i = 0; i < n; ++i)
-    bars[static_cast<std::size_t>(i)] = top > 0.0 ? (cdf[static_cast<std::size_t>(i) + 1] - cdf[static_cast<std::size_t>(i)]) / top : 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double p = cdf[static_cast<std::size_t>(i) + 1] - cdf[static_cast<std::size_t>(i)];
+    double& bar = bars[static_cast<std::size_t>(i)];
+    bar = top > 0.0 ? p / top : 0.0;
+    if (log_bars) bar = bar > 0.0 ? std::max(0.0, 1.0 + std::log10(bar) / 6.0) : 0.0;
+  }
   const draw::Plot plot(title, size, {0.0, degrees}, {0.0, 1.05}, x_label);
   // Bars without gaps: a row of 256 columns is narrower than a gap and its bar.
   for (int i = 0; i < n; ++i)
@@ -277,7 +284,7 @@ void cdf_plot(const char* title, const std::vector<double>& cdf, double degrees,
   }
   plot.line(xs, cdf, kCdf, 2.0f);
   char top_text[64];
-  std::snprintf(top_text, sizeof top_text, "probability (largest %.3g = 1)", top);
+  std::snprintf(top_text, sizeof top_text, log_bars ? "probability (log: 6 decades up to %.3g)" : "probability (largest %.3g = 1)", top);
   plot.legend({{"CDF", kCdf}, {top_text, kBars}}, true);
 }
 
@@ -427,6 +434,10 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
   same_line_if_fits(labelled(font * 6.0f, "samples/frame"));
   ImGui::SetNextItemWidth(font * 6.0f);
   ImGui::SliderInt("samples/frame", &s.samples_per_frame, 1, 20000, "%d", ImGuiSliderFlags_Logarithmic);
+  same_line_if_fits(ImGui::GetFrameHeight() + style.ItemInnerSpacing.x + ImGui::CalcTextSize("log bars").x);
+  ImGui::Checkbox("log bars", &s.log_bars);
+  layout::item("lab2d.log_bars");
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("The CDF plots' probabilities on a log scale (six decades)");
   if (!s.error.empty()) ImGui::TextColored(kRed, "%s", s.error.c_str());
   ImGui::TextWrapped("N = %llu directions by Environment::sample: u1 picks the row from the marginal CDF, u2 the column "
                      "from that row's conditional CDF; the density is P(texel) / the texel's solid angle.",
@@ -451,11 +462,12 @@ void draw_lab2d_window(Lab2dState& s, bool* open) {
   const ImVec2 plot((avail - gap) * 0.5f, std::max(font * 7.0f, rest - table_height));
   const int picked = s.picked_row();
   const double theta0 = 180.0 * picked / lab.map().height, theta1 = 180.0 * (picked + 1) / lab.map().height;
-  cdf_plot("marginal: P(row) and its CDF", lab.marginal_cdf(), 180.0, "theta (degrees from the zenith)", plot, picked);
+  cdf_plot("marginal: P(row) and its CDF", lab.marginal_cdf(), 180.0, "theta (degrees from the zenith)", plot, picked,
+           s.log_bars);
   ImGui::SameLine();
   char title[96];
   std::snprintf(title, sizeof title, "row %d (theta %.1f-%.1f): P(column | row)", picked, theta0, theta1);
-  cdf_plot(title, lab.conditional_cdf(picked), 360.0, "phi (degrees)", plot, -1);
+  cdf_plot(title, lab.conditional_cdf(picked), 360.0, "phi (degrees)", plot, -1, s.log_bars);
   resolution_table(s);
   ImGui::End();
 }

@@ -40,6 +40,7 @@ struct Lab2dState {
   int row = -1;       // the picked row at the current level (-1: the sun's, or the brightest)
   bool running = true;
   int samples_per_frame = 500;
+  bool log_bars = false;  // the CDF plots' bars on a log scale
   std::uint64_t max_samples = 1u << 20;
   std::array<float, 3> sized_for{};
 
