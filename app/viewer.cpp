@@ -1512,7 +1512,7 @@ void Viewer::Impl::write_layout_report(int fb_w, int fb_h) {
     extra["lab2d"] = {{"map", l->lab->name()},           {"width", l->lab->map().width},
                       {"height", l->lab->map().height}, {"row", l->picked_row()},
                       {"samples", l->lab->count()},     {"chi_square_p", chi.p_value},
-                      {"zero_cell_hits", chi.zero_cell_hits}};
+                      {"zero_cell_hits", chi.zero_cell_hits}, {"log_bars", l->log_bars}};
   }
   extra["quit_asking"] = quit_asking;
   extra["view"] = ui::view_mode_label(settings.measure.view_mode);

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # GUI test of the teaching views under Xvfb, driven with xdotool: split screen
 # (S, then dragging the divider), pixel probe (P, a click, C for chi-square)
-# the 1D lab (L, then a bad and a good f(x) typed) and the 2D lab (D: a row
-# picked on the map, a coarser resolution from its table). Each view is
+# the 1D lab (L, then a bad and a good f(x) typed) and the 2D lab (D: a
+# coarser resolution from its table, rows picked on the map, log bars). Each view is
 # captured; each capture must be non-blank and differ from the one before it.
 #   gui_teaching.sh PDFLAB SCENE ARTIFACT_DIR [DOCS_DIR]
 # With DOCS_DIR the views are rendered longer and saved there as
 # view_split.png, view_probe.png, view_lab1d.png (with a typed f(x)) and
-# lab2d.png (the sky at 64 x 32).
+# lab2d.png (the sky at 64 x 32, the sun's row, log bars).
 # Exit 77 only when xvfb-run itself is missing.
 set -euo pipefail
 
@@ -157,6 +157,9 @@ changed "$art/lab2d.png" "$art/lab2d_row.png"
 # Back up to the sun's row (9 of 32): its conditional CDF jumps at the sun's column.
 click_at "$((mx + mw / 2))" "$((my + mh * 19 / 64))"
 await_layout "d['lab2d']['row'] == 9"
+# The plots' probabilities on a log scale: the sky's rows and columns show beside the sun's.
+click lab2d.log_bars
+await_layout "d['lab2d']['log_bars']"
 sleep "$lab2d_settle"
 shot lab2d_sun
 changed "$art/lab2d_row.png" "$art/lab2d_sun.png"
