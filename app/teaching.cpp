@@ -1,5 +1,7 @@
 #include "app/teaching.h"
 
+#include "app/assets.h"
+
 #include "renderer/error.h"
 #include "renderer/film/image_io.h"
 #include "renderer/metrics/metrics.h"
@@ -39,6 +41,7 @@ bool TeachingViews::on_key(int key, RenderSession& main, bool paused) {
       probe_.open = probe_.mode && probe_.has_point;
       return true;
     case GLFW_KEY_L: lab_open_ = !lab_open_; return true;
+    case GLFW_KEY_D: lab2d_open_ = !lab2d_open_; return true;
     case GLFW_KEY_C:
       if (!probe_.has_point) return false;
       start_probe_chi_square(probe_, ImGui::GetTime());
@@ -51,6 +54,10 @@ bool TeachingViews::on_escape() {
   if (probe_.mode || probe_.open) {
     probe_.mode = false;
     probe_.open = false;
+    return true;
+  }
+  if (lab2d_open_) {
+    lab2d_open_ = false;
     return true;
   }
   if (lab_open_) {
@@ -274,6 +281,11 @@ void TeachingViews::draw_ui(RenderSession& main, const ui::Viewport& image, int 
   }
 
   if (lab_open_) ui::draw_lab1d_window(lab_, &lab_open_, area_width, area_height);
+  if (lab2d_open_) {
+    if (lab2d_.sun_sky_path.empty()) lab2d_.sun_sky_path = asset_dir() + "/environments/sun_sky.hdr";
+    lab2d_.set_scene_environment(main.settings().scene->environment);
+    ui::draw_lab2d_window(lab2d_, &lab2d_open_);
+  }
 }
 
 void TeachingViews::draw_split_image(const ui::Viewport& where, float exposure_ev, bool srgb) {
@@ -305,7 +317,8 @@ void TeachingViews::draw_split_image(const ui::Viewport& where, float exposure_e
 
 bool TeachingViews::wants_frames() const {
   return new_image_ || split_.divider.dragging || (lab_open_ && lab_.running && lab_.count() < lab_.max_samples) ||
-         (lab_open_ && lab_.pi_job.valid()) || probe_.chi_running();
+         (lab_open_ && lab_.pi_job.valid()) || probe_.chi_running() ||
+         (lab2d_open_ && lab2d_.running && (!lab2d_.lab || lab2d_.lab->count() < lab2d_.max_samples));
 }
 
 }  // namespace pdflab

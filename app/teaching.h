@@ -1,11 +1,13 @@
 #pragma once
 // The teaching views in the viewer: split screen A/B, the pixel probe and the
-// 1D lab. The viewer calls these few hooks; everything else about the views
-// lives here and in ui/split_view, ui/probe_panel, ui/lab1d_panel.
+// 1D and 2D labs. The viewer calls these few hooks; everything else about the
+// views lives here and in ui/split_view, ui/probe_panel, ui/lab1d_panel,
+// ui/lab2d_panel.
 #include "renderer/metrics/reference.h"
 #include "renderer/session/session.h"
 #include "ui/display.h"
 #include "ui/lab1d_panel.h"
+#include "ui/lab2d_panel.h"
 #include "ui/probe_panel.h"
 #include "ui/split_view.h"
 
@@ -24,9 +26,9 @@ class TeachingViews {
   TeachingViews(const TeachingViews&) = delete;
   TeachingViews& operator=(const TeachingViews&) = delete;
 
-  // S split, P probe mode, L 1D lab, C chi-square at the probed point.
+  // S split, P probe mode, L 1D lab, D 2D lab, C chi-square at the probed point.
   bool on_key(int glfw_key, RenderSession& main, bool paused);
-  // Esc: leaves probe mode, else closes the 1D lab. False when neither was on.
+  // Esc: leaves probe mode, else closes the 2D lab, else the 1D lab. False when none was on.
   bool on_escape();
   void leave_probe_mode() { probe_.mode = false; }
   // Before drawing: keeps the split sessions in step with the main session
@@ -46,6 +48,8 @@ class TeachingViews {
   const ui::SplitState* split_state() const { return split_.on ? &split_ : nullptr; }
   // Rendering time of the split's longer-running side (0 while it is off).
   double split_seconds() const { return split_.on ? std::max(split_.a.seconds, split_.b.seconds) : 0.0; }
+  // The 2D lab's state while it is open, else null (the layout report shows it).
+  const ui::Lab2dState* lab2d() const { return lab2d_open_ ? &lab2d_ : nullptr; }
   // The pixel probe's state (tests read its counts).
   const ui::ProbeState& probe() const { return probe_; }
   // OpenGL: both halves into `where`, A left of the divider.
@@ -75,6 +79,8 @@ class TeachingViews {
   std::string probe_b_;  // B's strategy when B was probed
   int probe_width_ = 0, probe_height_ = 0;  // the render's size when probed
   bool lab_open_ = false;
+  ui::Lab2dState lab2d_;
+  bool lab2d_open_ = false;
 
   std::unique_ptr<RenderSession> a_, b_;
   std::uint64_t seen_main_generation_ = ~std::uint64_t{0};

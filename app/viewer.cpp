@@ -1507,6 +1507,13 @@ void Viewer::Impl::write_layout_report(int fb_w, int fb_h) {
   extra["panel_hidden"] = settings.panel_hidden;
   extra["presentation"] = settings.presentation;
   extra["split"] = teaching->split_active();
+  if (const ui::Lab2dState* l = teaching->lab2d(); l && l->lab) {
+    const stats::ChiSquareResult chi = l->lab->chi_square();
+    extra["lab2d"] = {{"map", l->lab->name()},           {"width", l->lab->map().width},
+                      {"height", l->lab->map().height}, {"row", l->picked_row()},
+                      {"samples", l->lab->count()},     {"chi_square_p", chi.p_value},
+                      {"zero_cell_hits", chi.zero_cell_hits}, {"log_bars", l->log_bars}};
+  }
   extra["quit_asking"] = quit_asking;
   extra["view"] = ui::view_mode_label(settings.measure.view_mode);
   extra["done"] = status.stats.done;

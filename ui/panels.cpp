@@ -862,6 +862,7 @@ void draw_help_overlay(PanelState& state, float area_width, float area_height) {
         {"S", "split screen A/B: two strategies, equal time"},
         {"P", "pixel probe: click a pixel (C: chi-square)"},
         {"L", "1D lab: f, p, inverse CDF, pi"},
+        {"D", "2D lab: an environment map's marginal and conditional CDFs"},
         {"wheel", "zoom about the cursor (+ and - about the centre)"},
         {"drag", "pan (right or middle button; left outside probe mode)"},
         {"Z, F", "one image pixel per screen pixel; fit the window"},

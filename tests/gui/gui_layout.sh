@@ -4,7 +4,7 @@
 # side panel keeps to its share of the window, and the boxes over the image
 # (badges, the view's legend, the convergence plot, the pixel inspector, the
 # split's A and B boxes and its controls) overlap neither each other nor the
-# image's middle; the 1D lab fits the window. The panel's controls stay where
+# image's middle; the 1D and 2D labs fit the window. The panel's controls stay where
 # they are while the w slider is dragged and the curve recomputes (their
 # rectangles, and screenshots of the section below); the panel resizes by its
 # edge, hides by its button and by Tab, and the window size, panel width and
@@ -106,6 +106,15 @@ for config in "1280x720 1.5" "1280x720 2" "1920x1080 1"; do
     fail "the 1D lab does not fit the window"
   shot "${name}_lab"
   send_key l
+
+  echo "-- the 2D lab fits the window"
+  send_key d
+  await_layout "any(w['name'].startswith('2D lab') for w in d['windows'])"
+  sleep 0.3
+  [ "$(layout_py "all(x['x'] >= 0 and x['y'] >= 0 and x['x'] + x['w'] <= $w and x['y'] + x['h'] <= $h for x in d['windows'] if x['name'].startswith('2D lab'))")" = True ] ||
+    fail "the 2D lab does not fit the window"
+  shot "${name}_lab2d"
+  send_key d
   quit_viewer
 done
 

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # GUI test of the teaching views under Xvfb, driven with xdotool: split screen
 # (S, then dragging the divider), pixel probe (P, a click, C for chi-square)
-# and the 1D lab (L, then a bad and a good f(x) typed). Each view is captured; each capture must be non-blank
-# and differ from the one before it.
+# the 1D lab (L, then a bad and a good f(x) typed) and the 2D lab (D: a
+# coarser resolution from its table, rows picked on the map, log bars). Each view is
+# captured; each capture must be non-blank and differ from the one before it.
 #   gui_teaching.sh PDFLAB SCENE ARTIFACT_DIR [DOCS_DIR]
 # With DOCS_DIR the views are rendered longer and saved there as
-# view_split.png, view_probe.png, view_lab1d.png (with a typed f(x)).
+# view_split.png, view_probe.png, view_lab1d.png (with a typed f(x)) and
+# lab2d.png (the sky at 64 x 32, the sun's row, log bars).
 # Exit 77 only when xvfb-run itself is missing.
 set -euo pipefail
 
@@ -15,8 +17,8 @@ shift
 pdflab=$1 scene=$2 art=$3 docs=${4:-}
 rm -rf "$art"
 mkdir -p "$art"
-settle=2
-[ -n "$docs" ] && settle=12
+settle=2 lab2d_settle=0.5
+[ -n "$docs" ] && settle=12 lab2d_settle=12
 
 # not_blank FILE: some brightness and some structure.
 not_blank() {
@@ -122,6 +124,43 @@ not_blank "$art/lab_typed.png"
 changed "$art/lab_bad.png" "$art/lab_typed.png"
 awk -v r="$(red_line "$art/lab_typed.png")" 'BEGIN { exit !(r < 0.001) }' || fail "sin(pi*x)^2 was refused"
 [ -n "$docs" ] && cp "$art/lab_typed.png" "$docs/view_lab1d.png"
+
+echo "== 2D lab"
+send_key l
+send_key d
+await_layout "'lab2d' in d and d['lab2d']['width'] == 256 and d['lab2d']['samples'] > 0"
+sleep 0.3
+shot lab2d
+not_blank "$art/lab2d.png"
+changed "$art/lab_typed.png" "$art/lab2d.png"
+# The sun's texel is drawn at about its share of the light: the 2D histogram
+# agrees with the pdf, and no sample falls where the pdf is zero.
+awk -v p="$(layout_py "d['lab2d']['chi_square_p']")" 'BEGIN { exit !(p > 1e-6) }' || fail "the 2D lab's chi-square rejects its sampler"
+[ "$(layout_py "d['lab2d']['zero_cell_hits']")" = 0 ] || fail "2D lab: samples where the pdf is zero"
+# A coarser resolution from the table, then a row picked three eighths of the way down the map.
+click lab2d.level.64
+await_layout "d['lab2d']['width'] == 64 and d['lab2d']['height'] == 32"
+read -r mx my mw mh <<<"$(item lab2d.map)"
+# click_at X Y: the pointer rests there a moment before the click (a loaded machine's frame sees it arrive).
+click_at() {
+  xdotool mousemove "$1" "$2"
+  sleep 0.15
+  xdotool click 1
+  sleep 0.15
+  xdotool mousemove 2 2
+}
+click_at "$((mx + mw / 2))" "$((my + mh * 3 / 8 + 2))"
+await_layout "d['lab2d']['row'] == 12"
+# Back up to the sun's row (9 of 32): its conditional CDF jumps at the sun's column.
+click_at "$((mx + mw / 2))" "$((my + mh * 19 / 64))"
+await_layout "d['lab2d']['row'] == 9"
+# The plots' probabilities on a log scale: the sky's rows and columns show beside the sun's.
+click lab2d.log_bars
+await_layout "d['lab2d']['log_bars']"
+sleep "$lab2d_settle"
+shot lab2d_sun
+changed "$art/lab2d.png" "$art/lab2d_sun.png"
+[ -n "$docs" ] && cp "$art/lab2d_sun.png" "$docs/lab2d.png"
 
 quit_viewer
 echo "PASS"

@@ -1,8 +1,10 @@
 // The teaching views' plain parts: split-screen threads, divider and time
-// accounting, probe projection and binning, the 1D lab's state, plot maths.
+// accounting, probe projection and binning, the 1D and 2D labs' state, plot maths.
 #include "renderer/scene/scene_loader.h"
 #include "renderer/session/session.h"
+#include "renderer/scene/environment.h"
 #include "ui/lab1d_panel.h"
+#include "ui/lab2d_panel.h"
 #include "ui/probe_panel.h"
 #include "ui/split_view.h"
 #include "ui/teach_draw.h"
@@ -303,6 +305,54 @@ TEST(Lab1d, StratifiedPiBeatsPlainAtLargeN) {
   EXPECT_EQ(p.n.back(), 16384.0);
   EXPECT_LT(p.stratified_error.back(), p.plain_error.back());
   EXPECT_LT(p.plain_error.back(), p.plain_error.front());
+}
+
+TEST(Lab2d, AClickOnTheMapPicksTheRowUnderIt) {
+  EXPECT_EQ(lab2d_row_at(0.0, 32), 0);
+  EXPECT_EQ(lab2d_row_at(0.375, 32), 12);
+  EXPECT_EQ(lab2d_row_at(0.999, 32), 31);
+  EXPECT_EQ(lab2d_row_at(1.0, 32), 31);  // the bottom edge
+  EXPECT_EQ(lab2d_row_at(-0.2, 32), 0);  // a drag above the map
+  EXPECT_EQ(lab2d_row_at(std::nan(""), 32), 0);
+}
+
+TEST(Lab2d, StateFollowsTheMapTheLevelAndTheScene) {
+  Lab2dState s;
+  s.sun_sky_path = PDFLAB_SOURCE_DIR "/assets/environments/sun_sky.hdr";
+  ASSERT_TRUE(s.choose(Lab2dState::Source::SunSky));
+  ASSERT_TRUE(s.lab);
+  // By default the row shown is the sun's.
+  EXPECT_EQ(s.picked_row(), 39);
+  s.set_level(2);  // 64 x 32
+  EXPECT_EQ(s.picked_row(), 9);
+  s.row = 20;
+  s.set_level(1);  // 128 x 64: the picked row stays at the same place on the sphere
+  EXPECT_EQ(s.picked_row(), 41);
+  s.step();
+  EXPECT_EQ(s.lab->count(), static_cast<std::uint64_t>(s.samples_per_frame));
+  // Another map at the same resolution; its row is its own again.
+  ASSERT_TRUE(s.choose(Lab2dState::Source::Constant));
+  EXPECT_EQ(s.lab->map().width, 128);
+  EXPECT_EQ(s.row, -1);
+  // No scene map: refused with a reason, the lab kept.
+  EXPECT_FALSE(s.choose(Lab2dState::Source::Scene));
+  EXPECT_NE(s.error.find("no environment map"), std::string::npos) << s.error;
+  EXPECT_EQ(s.source, Lab2dState::Source::Constant);
+  // A scene map given: chosen, and followed when the scene's map changes.
+  auto env = std::make_shared<const Environment>(std::vector<float>(16 * 8 * 3, 1.0f), 16, 8, 1.0f, 0.0f);
+  s.set_scene_environment(env);
+  ASSERT_TRUE(s.choose(Lab2dState::Source::Scene));
+  EXPECT_TRUE(s.error.empty());
+  EXPECT_EQ(s.lab->map().width, 16);
+  auto other = std::make_shared<const Environment>(std::vector<float>(32 * 16 * 3, 2.0f), 32, 16, 1.0f, 0.0f);
+  s.set_scene_environment(other);
+  EXPECT_EQ(s.lab->levels(), 3);  // 32, 16, 8 across
+  s.set_scene_environment(nullptr);  // a scene without a map: back to the shipped sky
+  EXPECT_EQ(s.source, Lab2dState::Source::SunSky);
+  // A sky file that is not there: the reason names it.
+  s.sun_sky_path = "/nonexistent/sky.hdr";
+  EXPECT_FALSE(s.choose(Lab2dState::Source::SunSky));
+  EXPECT_NE(s.error.find("/nonexistent/sky.hdr"), std::string::npos) << s.error;
 }
 
 TEST(PlotMath, AxesTicksAndColours) {
