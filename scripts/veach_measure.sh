@@ -3,7 +3,8 @@
 #   1. a reference of assets/scenes/veach_mis.json (pdflab reference, 4096 spp of
 #      nee-mis+mix:bsdf=0.5,light-sa=0.5: at least 64x every run below);
 #   2. the four estimators at equal time: each timed at SPP samples per pixel
-#      on one thread, then given SPP * (fastest time / its time) samples;
+#      on one thread (the best of five, in turn), then given SPP * (fastest
+#      time / its time) samples;
 #   3. SEEDS renders of each (--reference: the whole image's relMSE in each summary);
 #   4. scripts/veach_table.py: relMSE per plate and per plate-light pair;
 #      scripts/veach_panel.py: the four renders of the first seed as one PNG.
@@ -23,16 +24,16 @@ strategies=("bsdf" "light-sa" "nee-mis:balance+bsdf" "nee-mis+bsdf")
 [ -f "$out/ref.pfm" ] || "$pdflab" reference --scene "$scene" --strategy "nee-mis+mix:bsdf=0.5,light-sa=0.5" \
   --spp "$ref_spp" --out "$out/ref.pfm" --cache-dir "$out/cache" --quiet
 
-# Seconds per render at $spp on one thread (the best of three).
+# Seconds per render at $spp on one thread: the best of five, the estimators
+# taken in turn (A B C D A B C D ...) so that a drift in the machine's speed
+# falls on all four alike.
 declare -a seconds
-for i in "${!strategies[@]}"; do
-  best=
-  for k in 1 2 3; do
+for k in 1 2 3 4 5; do
+  for i in "${!strategies[@]}"; do
     t=$("$pdflab" render --scene "$scene" --strategy "${strategies[$i]}" --spp "$spp" --seed 7 --threads 1 \
           --out "$out/timing.pfm" --quiet 2>&1 | head -1 | awk '{print $4}')
-    best=$(awk -v a="${best:-$t}" -v b="$t" 'BEGIN{print (b < a) ? b : a}')
+    seconds[$i]=$(awk -v a="${seconds[$i]:-$t}" -v b="$t" 'BEGIN{print (b < a) ? b : a}')
   done
-  seconds[$i]=$best
 done
 fastest=$(printf '%s\n' "${seconds[@]}" | sort -g | head -1)
 
