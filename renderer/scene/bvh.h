@@ -27,7 +27,7 @@ struct Sphere;
 // From this many objects (quads and spheres together) on, Scene::prepare
 // builds the tree (BvhUse::Auto); below it the flat loop is faster
 // (docs/many_lights.md, "The BVH over objects", measures the crossing).
-inline constexpr int kBvhObjectThreshold = 40;
+inline constexpr int kBvhObjectThreshold = 50;
 
 // Whether Scene::prepare builds the tree: above the threshold, always (the
 // tests compare the two), or never.
