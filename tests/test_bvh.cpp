@@ -15,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -238,11 +240,21 @@ TEST(Bvh, FindsTheFlatLoopsNearestHitInTheObjectRoom) {
   EXPECT_GT(t.hits, 8000);
 }
 
+// The deepest leaf's depth (the root's is 1).
+int tree_depth(const Bvh& bvh, std::int32_t at = 0) {
+  const BvhNode& node = bvh.nodes[static_cast<std::size_t>(at)];
+  if (node.count) return 1;
+  return 1 + std::max(tree_depth(bvh, at + 1), tree_depth(bvh, node.index));
+}
+
 // Degenerate scenes: every object at one point (every hit a tie: the first
-// object wins), and objects from 1e-4 to 1e6 across side by side.
+// object wins), objects from 1e-4 to 1e6 across side by side, and objects
+// crowding towards one point, each a quarter-octave nearer to it than the
+// last, the last ones at the same point in float.
 TEST(Bvh, DegenerateScenes) {
-  for (int which = 0; which < 2; ++which) {
-    SCOPED_TRACE(which == 0 ? "all at one point" : "huge and tiny");
+  const char* const names[] = {"all at one point", "huge and tiny", "crowding towards a point"};
+  for (int which = 0; which < 3; ++which) {
+    SCOPED_TRACE(names[which]);
     Scene scenes[2];
     for (int k = 0; k < 2; ++k) {
       Scene& s = scenes[k];
@@ -253,6 +265,10 @@ TEST(Bvh, DegenerateScenes) {
         if (which == 0) {
           s.quads.push_back(make_quad({250, 250, 250}, {40, 0, 0}, {0, 40, 0}, 0));
           s.spheres.push_back(Sphere{{270, 270, 250}, 20.0f, 0});
+        } else if (which == 2) {
+          const float step = std::ldexp(1.0f, -i / 4);  // 1 down to 2^-74: the last ones coincide in float
+          s.quads.push_back(make_quad(Vec3(100.0f + 300.0f * step, 250, 250), {step, 0, 0}, {0, step, 0}, 0));
+          s.spheres.push_back(Sphere{Vec3(250, 100.0f + 300.0f * step, 250), 0.5f * step + 1e-3f, 0});
         } else {
           const float size = i % 3 == 0 ? 1e-4f : i % 3 == 1 ? 1.0f : 30.0f;
           s.quads.push_back(make_quad(random_point(rng, 100, 400), {size, 0, size}, {0, size, 0}, 0));
@@ -266,13 +282,23 @@ TEST(Bvh, DegenerateScenes) {
     const Bvh& bvh = scenes[1].bvh;
     ASSERT_FALSE(bvh.empty());
     EXPECT_EQ(bvh.objects.size(), scenes[1].quads.size() + scenes[1].spheres.size());
-    // Every node's objects are listed once, and no leaf is over-full.
-    for (const BvhNode& node : bvh.nodes) EXPECT_LE(node.count, Bvh::kMaxLeaf);
+    // Every object is in one leaf, no leaf is over-full, no walk deeper than its stack.
+    std::vector<int> seen(bvh.objects.size(), 0);
+    for (const BvhNode& node : bvh.nodes) {
+      EXPECT_LE(node.count, Bvh::kMaxLeaf);
+      for (int k = 0; k < node.count; ++k) ++seen[static_cast<std::size_t>(bvh.objects[static_cast<std::size_t>(node.index + k)])];
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(seen.size()));
+    EXPECT_LE(tree_depth(bvh), Bvh::kMaxDepth);
+    std::printf("%s: %zu nodes, depth %d\n", names[which], bvh.nodes.size(), tree_depth(bvh));
     std::vector<TracedRay> rays = troubling_rays(scenes[0], 4000, 13);
     Rng rng(8, 8);
     for (int i = 0; i < 2000; ++i) {  // at the point, or at a tiny object
       const Vec3 o = random_point(rng, 0, 555);
-      const Vec3 at = which == 0 ? Vec3(265, 265, 250) : scenes[0].spheres[static_cast<std::size_t>(3 * (i % 100))].center;
+      const Vec3 at = which == 0   ? Vec3(265, 265, 250)
+                      : which == 1 ? scenes[0].spheres[static_cast<std::size_t>(3 * (i % 100))].center
+                      : i % 2      ? scenes[0].spheres[static_cast<std::size_t>(i % 120)].center
+                                   : scenes[0].quads[static_cast<std::size_t>(i % 120)].q;
       rays.push_back({o, normalize(at - o)});
     }
     Tally t;
