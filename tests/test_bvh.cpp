@@ -252,8 +252,9 @@ int tree_depth(const Bvh& bvh, std::int32_t at = 0) {
 // crowding towards one point, each a quarter-octave nearer to it than the
 // last, the last ones at the same point in float.
 TEST(Bvh, DegenerateScenes) {
-  const char* const names[] = {"all at one point", "huge and tiny", "crowding towards a point"};
-  for (int which = 0; which < 3; ++which) {
+  const char* const names[] = {"all at one point", "huge and tiny", "crowding towards a point",
+                               "near float's largest coordinates"};
+  for (int which = 0; which < 4; ++which) {
     SCOPED_TRACE(names[which]);
     Scene scenes[2];
     for (int k = 0; k < 2; ++k) {
@@ -265,6 +266,9 @@ TEST(Bvh, DegenerateScenes) {
         if (which == 0) {
           s.quads.push_back(make_quad({250, 250, 250}, {40, 0, 0}, {0, 40, 0}, 0));
           s.spheres.push_back(Sphere{{270, 270, 250}, 20.0f, 0});
+        } else if (which == 3) {
+          s.quads.push_back(make_quad(random_point(rng, -1.5e38f, 1.5e38f), {1e18f, 0, 0}, {0, 1e18f, 1e18f}, 0));
+          s.spheres.push_back(Sphere{random_point(rng, -1.5e38f, 1.5e38f), 1e37f, 0});
         } else if (which == 2) {
           const float step = std::ldexp(1.0f, -i / 4);  // 1 down to 2^-74: the last ones coincide in float
           s.quads.push_back(make_quad(Vec3(100.0f + 300.0f * step, 250, 250), {step, 0, 0}, {0, step, 0}, 0));
@@ -291,18 +295,20 @@ TEST(Bvh, DegenerateScenes) {
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(seen.size()));
     EXPECT_LE(tree_depth(bvh), Bvh::kMaxDepth);
     std::printf("%s: %zu nodes, depth %d\n", names[which], bvh.nodes.size(), tree_depth(bvh));
-    std::vector<TracedRay> rays = troubling_rays(scenes[0], 4000, 13);
+    std::vector<TracedRay> rays = which == 3 ? std::vector<TracedRay>{} : troubling_rays(scenes[0], 4000, 13);
     Rng rng(8, 8);
     for (int i = 0; i < 2000; ++i) {  // at the point, or at a tiny object
-      const Vec3 o = random_point(rng, 0, 555);
+      const Vec3 o = which == 3 ? random_point(rng, -1e38f, 1e38f) : random_point(rng, 0, 555);
       const Vec3 at = which == 0   ? Vec3(265, 265, 250)
                       : which == 1 ? scenes[0].spheres[static_cast<std::size_t>(3 * (i % 100))].center
                       : i % 2      ? scenes[0].spheres[static_cast<std::size_t>(i % 120)].center
+                      : which == 3 ? scenes[0].quads[static_cast<std::size_t>(i % 120)].q + Vec3(5e17f, 1e17f, 4e17f)
                                    : scenes[0].quads[static_cast<std::size_t>(i % 120)].q;
-      rays.push_back({o, normalize(at - o)});
+      rays.push_back({o, unit_direction(at - o)});
     }
     Tally t;
     expect_same_hits(scenes[0], scenes[1], rays, t);
+    EXPECT_GT(t.hits, 1000);
     if (which == 0) {
       EXPECT_GT(t.ties, 1000);
     }

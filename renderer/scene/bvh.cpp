@@ -92,9 +92,15 @@ class Builder {
     for (int i = begin; i < end; ++i) bvh_.objects.push_back(items_[static_cast<std::size_t>(i)].object);
   }
 
-  static int bin_of(float centre, float lo, float extent) {
-    const int b = static_cast<int>(static_cast<float>(kBins) * ((centre - lo) / extent));
-    return std::clamp(b, 0, kBins - 1);
+  // In double, and clamped before it becomes an int: centres near float's
+  // largest values would overflow float's differences (and a NaN or an
+  // infinity turned into an int is undefined).
+  static int bin_of(float centre, float lo, double extent) {
+    const double x = kBins * ((static_cast<double>(centre) - lo) / extent);
+    return x >= kBins - 1 ? kBins - 1 : x > 0.0 ? static_cast<int>(x) : 0;
+  }
+  static double spread(const Box& centres, int axis) {
+    return static_cast<double>(centres.hi[axis]) - centres.lo[axis];
   }
 
   // Where to split [begin, end) (`middle`, the items reordered), or -1: a
@@ -105,8 +111,8 @@ class Builder {
     int best_axis = -1, best_split = 0;
     if (depth < kHeuristicDepth) {
       for (int a = 0; a < 3; ++a) {
-        const float extent = centres.hi[a] - centres.lo[a];
-        if (!(extent > 0.0f)) continue;
+        const double extent = spread(centres, a);
+        if (!(extent > 0.0)) continue;
         Box bins[kBins];
         int counts[kBins] = {};
         for (int i = begin; i < end; ++i) {
@@ -144,7 +150,7 @@ class Builder {
       // The centres coincide, or the tree is deep: halves by count, along the widest spread of centres.
       axis = 0;
       for (int a = 1; a < 3; ++a)
-        if (centres.hi[a] - centres.lo[a] > centres.hi[axis] - centres.lo[axis]) axis = a;
+        if (spread(centres, a) > spread(centres, axis)) axis = a;
       middle = begin + n / 2;
       const auto first = items_.begin() + begin;
       std::nth_element(first, items_.begin() + middle, items_.begin() + end, [&](const Item& x, const Item& y) {
@@ -153,7 +159,8 @@ class Builder {
       return;
     }
     axis = best_axis;
-    const float lo = centres.lo[axis], extent = centres.hi[axis] - centres.lo[axis];
+    const float lo = centres.lo[axis];
+    const double extent = spread(centres, axis);
     const auto split = std::partition(items_.begin() + begin, items_.begin() + end,
                                       [&](const Item& item) { return bin_of(item.centre[axis], lo, extent) < best_split; });
     middle = static_cast<int>(split - items_.begin());
@@ -185,7 +192,7 @@ Bvh Bvh::build(const std::vector<Quad>& quads, const std::vector<Sphere>& sphere
     Box own;
     for (const Vec3& corner : {q.q, q.q + q.u, q.q + q.v, q.q + q.u + q.v}) own.grow(corner);
     const Vec3 m(object_margin(q, scale));
-    items.push_back({{own.lo - m, own.hi + m}, (own.lo + own.hi) * 0.5f, static_cast<std::int32_t>(items.size())});
+    items.push_back({{own.lo - m, own.hi + m}, own.lo * 0.5f + own.hi * 0.5f, static_cast<std::int32_t>(items.size())});
   }
   for (const Sphere& s : spheres) {
     const Vec3 reach(s.radius + object_margin(s, scale));
