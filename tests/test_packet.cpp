@@ -5,6 +5,7 @@
 #include "renderer/error.h"
 #include "renderer/integrator/integrator.h"
 #include "renderer/integrator/packet.h"
+#include "renderer/scene/object_room.h"
 #include "renderer/scene/scene_loader.h"
 #include "tests/table_strategies.h"
 
@@ -204,6 +205,45 @@ TEST(Packet, EnvironmentAndAreaLight) {
       EXPECT_GE(c.nonzero, 1000u);
     }
   }
+}
+
+// A scene of many objects rendered with the tree over them (Scene::bvh) and
+// without: the same bits through the one-path tracer and every packet width,
+// shadow rays, aimed light samples and bounces included.
+TEST(Packet, TheTreeOverObjectsGivesTheFlatLoopsBits) {
+  constexpr int kWidth = 24, kHeight = 20;
+  Scene flat = object_room(300, 2, BvhUse::Never), tree = object_room(300, 2, BvhUse::Always);
+  for (Scene* scene : {&flat, &tree}) {
+    scene->camera.width = kWidth;
+    scene->camera.height = kHeight;
+    scene->prepare();
+  }
+  ASSERT_TRUE(flat.bvh.empty());
+  ASSERT_FALSE(tree.bvh.empty());
+  std::size_t nonzero = 0, samples = 0;
+  for (const char* strategy : {"nee-mis", "cosine+rr", "nee-mis:balance+mix:cosine=0.5,light-sa=0.5"}) {
+    SCOPED_TRACE(strategy);
+    const SamplingPlan flat_plan = SamplingPlan::make(Strategy::parse(strategy), flat);
+    const SamplingPlan tree_plan = SamplingPlan::make(Strategy::parse(strategy), tree);
+    const SampleBlock block{0, 0, kWidth, kHeight, 0, 3};
+    for (PacketIsa isa : available_packet_isas()) {
+      std::vector<SampleResult> a(block.size()), b(block.size());
+      trace_block(isa, flat, flat_plan, 5, block, a.data());
+      trace_block(isa, tree, tree_plan, 5, block, b.data());
+      std::size_t differing = 0;
+      for (std::size_t j = 0; j < a.size(); ++j) {
+        differing += !same_bits(a[j].radiance, b[j].radiance) || a[j].drops != b[j].drops;
+        nonzero += a[j].radiance != Vec3(0.0f);
+      }
+      samples += a.size();
+      EXPECT_EQ(differing, 0u) << packet_isa_name(isa);
+      // And the one-path tracer with the tree gives the packets' bits.
+      const Comparison c = compare(isa, tree, tree_plan, 5, block);
+      EXPECT_EQ(c.differing, 0u) << packet_isa_name(isa) << ": " << c.first_difference;
+    }
+  }
+  // Thousands of samples found light (nee-mis's light samples): no comparison of black images.
+  EXPECT_GE(nonzero, samples / 3);
 }
 
 // The instruction sets: the baseline always, narrowest first, each wider than

@@ -114,7 +114,15 @@ void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, co
   PDFLAB_PACKET_CALL(isa, plan_pdf_impl(plan, draws, directions, n, out));
 }
 
+void nearest_hits(PacketIsa isa, const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out) {
+  PDFLAB_PACKET_CALL(isa, nearest_hits_impl(scene, rays, n, out));
+}
+
 #undef PDFLAB_PACKET_CALL
+
+void nearest_hits(const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out) {
+  packet_one::nearest_hits_impl(scene, rays, n, out);
+}
 
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
                  SampleResult* out) {

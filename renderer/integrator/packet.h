@@ -87,4 +87,23 @@ void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws,
 void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,
               float* out);
 
+// A ray as a path follows it, for nearest_hits: aimed at object `aimed` (a
+// quad's number, or a sphere's: quads, then spheres; -1: none) at distance
+// `aimed_t` (leaf::Sampled::aimed_quad and aimed_distance).
+struct TracedRay {
+  Vec3 origin, direction;
+  std::int32_t aimed = -1;
+  float aimed_t = 0.0f;
+};
+struct NearestHit {
+  float t;
+  std::int32_t object;  // -1: none
+};
+// The nearest hits that the paths find along `rays` (the tracer's intersection,
+// with the scene's tree where it has one), packet_lanes(isa) rays at a time,
+// for the tests that compare them with and without the tree.
+void nearest_hits(PacketIsa isa, const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out);
+// The same through the one-path tracer, a ray at a time.
+void nearest_hits(const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out);
+
 }  // namespace pdflab

@@ -76,7 +76,8 @@ namespace pdflab {
                         const SampleBlock& block, SampleResult* out);                                        \
   void sample_plan_impl(const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out); \
   void plan_pdf_impl(const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,  \
-                     float* out);
+                     float* out);                                                                            \
+  void nearest_hits_impl(const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out);
 
 namespace packet_generic {
 PDFLAB_PACKET_KERNEL_ENTRIES

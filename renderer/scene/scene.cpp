@@ -141,9 +141,11 @@ inline int closest_in_batch(const QuadBatch& b, const Ray& ray, float& closest) 
     best_t = hit ? t : best_t;
     best_i = hit ? index : best_i;
   }
+  // The nearest, the first of equals (a lane without a hit keeps best_t at
+  // `closest`'s start and index -1, below every lane's index).
   int best = -1;
   for (int lane = 0; lane < kLanes; ++lane) {
-    const bool nearer = best_t[lane] < closest;
+    const bool nearer = best_t[lane] < closest || (best_t[lane] == closest && best_i[lane] < best);
     best = nearer ? best_i[lane] : best;
     closest = nearer ? best_t[lane] : closest;
   }
@@ -196,6 +198,10 @@ void Scene::prepare() {
     sp.float_test = s <= 16.0f * sp.radius && static_cast<double>(sp.radius) <= 2.0 * smallest &&
                     sp.radius <= kLargestFloatTestRadius;
   }
+  const auto objects = quads.size() + spheres.size();
+  const bool tree = bvh_use == BvhUse::Always ||
+                    (bvh_use == BvhUse::Auto && objects >= static_cast<std::size_t>(kBvhObjectThreshold));
+  bvh = tree ? Bvh::build(quads, spheres, scale) : Bvh{};
 }
 
 namespace {
@@ -212,7 +218,35 @@ Hit sphere_hit(const Sphere& s, const Ray& ray, float t) {
 }
 }  // namespace
 
+namespace {
+// The nearest hit among the objects whose boxes the ray reaches in the scene's
+// tree: each by the flat loop's arithmetic, the nearest winning and the first
+// of equals by object number, so it is the flat loop's hit.
+bool intersect_tree(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
+  const auto nq = static_cast<std::int32_t>(scene.quads.size());
+  float closest = t_max;
+  std::int32_t best = -1;
+  scene.bvh.walk(ray.origin, ray.direction, closest, [&](std::int32_t object) {
+    bool found;
+    float t;
+    if (object < nq) {
+      t = quad_hit_distance(scene.quads[static_cast<std::size_t>(object)], ray.origin, ray.direction);
+      found = t > 0.0f;
+    } else {
+      t = leaf::sphere_hit_distance(scene.spheres[static_cast<std::size_t>(object - nq)], ray.origin, ray.direction,
+                                    t_max, found);
+    }
+    if (found && (t < closest || (t == closest && object < best))) closest = t, best = object;
+  });
+  if (best < 0) return false;
+  hit = best < nq ? quad_hit(scene.quads[static_cast<std::size_t>(best)], ray, closest)
+                  : sphere_hit(scene.spheres[static_cast<std::size_t>(best - nq)], ray, closest);
+  return true;
+}
+}  // namespace
+
 bool intersect(const Scene& scene, const Ray& ray, float t_max, Hit& hit) {
+  if (scene.bvh.covers(scene.quads.size(), scene.spheres.size())) return intersect_tree(scene, ray, t_max, hit);
   int best_quad = -1, best_sphere = -1;
   float closest = t_max;
   if (scene.quad_batch.count == static_cast<int>(scene.quads.size())) {

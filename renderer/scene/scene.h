@@ -2,6 +2,7 @@
 // The scene as flat arrays of plain structs. Boxes are already six quads and
 // rotations/translations are baked into the geometry by the loader.
 #include "renderer/math.h"
+#include "renderer/scene/bvh.h"
 
 #include <array>
 #include <memory>
@@ -161,8 +162,14 @@ struct Scene {
   std::array<double, 3> origin{};
   float scale = 1.0f;  // largest coordinate magnitude (in the rendering space)
   QuadBatch quad_batch;  // derived from quads by prepare()
+  // The tree over the objects (renderer/scene/bvh.h), built by prepare() where
+  // `bvh_use` asks for it: by default from kBvhObjectThreshold objects on.
+  // Both tracers and intersect() walk it where it covers the scene's objects;
+  // an image is the same bits with it as without.
+  Bvh bvh;
+  BvhUse bvh_use = BvhUse::Auto;
 
-  // Builds derived data (camera basis, quad batch). Call after editing the
+  // Builds derived data (camera basis, quad batch, the tree). Call after editing the
   // scene; intersect() falls back to a scalar loop while the batch is stale.
   void prepare();
 };

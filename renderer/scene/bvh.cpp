@@ -1,0 +1,208 @@
+#include "renderer/scene/bvh.h"
+
+#include "renderer/scene/scene.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace pdflab {
+
+namespace {
+
+// The widening of an object's box against the scene's extent: 2^-14 is 2^10
+// float steps. The float tests' error in where they find a hit is a few steps
+// of the coordinates involved (origin, distance, the object's corner, at most
+// about 12 `scale` together), times the quad's skew: a margin of 2^10 steps
+// leaves a factor above ten to spare.
+constexpr float kMarginPerScale = 0x1.0p-14f;
+
+struct Box {
+  Vec3 lo{kInf}, hi{-kInf};
+  void grow(const Vec3& p) {
+    lo = Vec3(min_of(lo.x, p.x), min_of(lo.y, p.y), min_of(lo.z, p.z));
+    hi = Vec3(max_of(hi.x, p.x), max_of(hi.y, p.y), max_of(hi.z, p.z));
+  }
+  void grow(const Box& b) {
+    grow(b.lo);
+    grow(b.hi);
+  }
+  // Half the surface area (the heuristic needs only ratios); 0 when empty.
+  double half_area() const {
+    if (!(lo.x <= hi.x)) return 0.0;
+    const double x = static_cast<double>(hi.x) - lo.x, y = static_cast<double>(hi.y) - lo.y,
+                 z = static_cast<double>(hi.z) - lo.z;
+    return x * y + y * z + z * x;
+  }
+};
+
+struct Item {
+  Box box;      // widened
+  Vec3 centre;  // of the object's own box
+  std::int32_t object;
+};
+
+constexpr int kBins = 16;
+// Below this depth the heuristic chooses the splits; from it on the objects
+// are halved by count, so no tree is deeper than Bvh::kMaxDepth for up to
+// kMaxLeaf * 2^(kMaxDepth - kHeuristicDepth - 1) objects.
+constexpr int kHeuristicDepth = 40;
+// A node's cost against a leaf's: one box test against one object test.
+constexpr double kTraversalCost = 1.0;
+
+class Builder {
+ public:
+  Builder(std::vector<Item>& items, Bvh& bvh) : items_(items), bvh_(bvh) {}
+
+  std::int32_t build(int begin, int end, int depth) {
+    const auto at = static_cast<std::int32_t>(bvh_.nodes.size());
+    bvh_.nodes.emplace_back();
+    Box box, centres;
+    for (int i = begin; i < end; ++i) {
+      box.grow(items_[static_cast<std::size_t>(i)].box);
+      centres.grow(items_[static_cast<std::size_t>(i)].centre);
+    }
+    const int n = end - begin;
+    int middle = -1, axis = 0;
+    if (n > 1) choose_split(begin, end, depth, box, centres, middle, axis);
+    if (middle < 0) {
+      make_leaf(at, box, begin, end);
+      return at;
+    }
+    build(begin, middle, depth + 1);  // the next node
+    const std::int32_t second = build(middle, end, depth + 1);
+    BvhNode& node = bvh_.nodes[static_cast<std::size_t>(at)];
+    set_box(node, box);
+    node.index = second;
+    node.count = 0;
+    node.axis = static_cast<std::uint8_t>(axis);
+    return at;
+  }
+
+ private:
+  static void set_box(BvhNode& node, const Box& box) {
+    for (int a = 0; a < 3; ++a) node.lo[a] = box.lo[a], node.hi[a] = box.hi[a];
+  }
+
+  void make_leaf(std::int32_t at, const Box& box, int begin, int end) {
+    BvhNode& node = bvh_.nodes[static_cast<std::size_t>(at)];
+    set_box(node, box);
+    node.index = static_cast<std::int32_t>(bvh_.objects.size());
+    node.count = static_cast<std::uint16_t>(end - begin);
+    for (int i = begin; i < end; ++i) bvh_.objects.push_back(items_[static_cast<std::size_t>(i)].object);
+  }
+
+  // In double, and clamped before it becomes an int: centres near float's
+  // largest values would overflow float's differences (and a NaN or an
+  // infinity turned into an int is undefined).
+  static int bin_of(float centre, float lo, double extent) {
+    const double x = kBins * ((static_cast<double>(centre) - lo) / extent);
+    return x >= kBins - 1 ? kBins - 1 : x > 0.0 ? static_cast<int>(x) : 0;
+  }
+  static double spread(const Box& centres, int axis) {
+    return static_cast<double>(centres.hi[axis]) - centres.lo[axis];
+  }
+
+  // Where to split [begin, end) (`middle`, the items reordered), or -1: a
+  // leaf is cheaper and small enough.
+  void choose_split(int begin, int end, int depth, const Box& box, const Box& centres, int& middle, int& axis) {
+    const int n = end - begin;
+    double best_cost = kInf;
+    int best_axis = -1, best_split = 0;
+    if (depth < kHeuristicDepth) {
+      for (int a = 0; a < 3; ++a) {
+        const double extent = spread(centres, a);
+        if (!(extent > 0.0)) continue;
+        Box bins[kBins];
+        int counts[kBins] = {};
+        for (int i = begin; i < end; ++i) {
+          const Item& item = items_[static_cast<std::size_t>(i)];
+          const int b = bin_of(item.centre[a], centres.lo[a], extent);
+          bins[b].grow(item.box);
+          ++counts[b];
+        }
+        // Sweeps from the right, then the left: the cost of each of the kBins - 1 planes.
+        double right_area[kBins];
+        int right_count[kBins];
+        Box right;
+        int count = 0;
+        for (int b = kBins - 1; b > 0; --b) {
+          right.grow(bins[b]);
+          count += counts[b];
+          right_area[b] = right.half_area();
+          right_count[b] = count;
+        }
+        Box left;
+        count = 0;
+        for (int b = 0; b + 1 < kBins; ++b) {
+          left.grow(bins[b]);
+          count += counts[b];
+          if (count == 0 || right_count[b + 1] == 0) continue;
+          const double cost = left.half_area() * count + right_area[b + 1] * right_count[b + 1];
+          if (cost < best_cost) best_cost = cost, best_axis = a, best_split = b + 1;
+        }
+      }
+    }
+    const double area = box.half_area();
+    const double split_cost = area > 0.0 ? kTraversalCost + best_cost / area : kInf;
+    if (n <= Bvh::kMaxLeaf && !(split_cost < static_cast<double>(n))) return;  // a leaf
+    if (best_axis < 0) {
+      // The centres coincide, or the tree is deep: halves by count, along the widest spread of centres.
+      axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (spread(centres, a) > spread(centres, axis)) axis = a;
+      middle = begin + n / 2;
+      const auto first = items_.begin() + begin;
+      std::nth_element(first, items_.begin() + middle, items_.begin() + end, [&](const Item& x, const Item& y) {
+        return x.centre[axis] < y.centre[axis] || (x.centre[axis] == y.centre[axis] && x.object < y.object);
+      });
+      return;
+    }
+    axis = best_axis;
+    const float lo = centres.lo[axis];
+    const double extent = spread(centres, axis);
+    const auto split = std::partition(items_.begin() + begin, items_.begin() + end,
+                                      [&](const Item& item) { return bin_of(item.centre[axis], lo, extent) < best_split; });
+    middle = static_cast<int>(split - items_.begin());
+  }
+
+  std::vector<Item>& items_;
+  Bvh& bvh_;
+};
+
+}  // namespace
+
+float object_margin(const Quad& quad, float scale) {
+  const float skew = length(quad.u) * length(quad.alpha_axis) + length(quad.v) * length(quad.beta_axis);
+  const float size = max_abs_component(quad.q) + max_abs_component(quad.u) + max_abs_component(quad.v);
+  return kMarginPerScale * max_of(scale, size) * (1.0f + skew);
+}
+
+float object_margin(const Sphere& sphere, float scale) {
+  return kMarginPerScale * max_of(scale, max_abs_component(sphere.center) + sphere.radius);
+}
+
+Bvh Bvh::build(const std::vector<Quad>& quads, const std::vector<Sphere>& spheres, float scale) {
+  Bvh bvh;
+  bvh.quads = static_cast<int>(quads.size());
+  bvh.spheres = static_cast<int>(spheres.size());
+  std::vector<Item> items;
+  items.reserve(quads.size() + spheres.size());
+  for (const Quad& q : quads) {
+    Box own;
+    for (const Vec3& corner : {q.q, q.q + q.u, q.q + q.v, q.q + q.u + q.v}) own.grow(corner);
+    const Vec3 m(object_margin(q, scale));
+    items.push_back({{own.lo - m, own.hi + m}, own.lo * 0.5f + own.hi * 0.5f, static_cast<std::int32_t>(items.size())});
+  }
+  for (const Sphere& s : spheres) {
+    const Vec3 reach(s.radius + object_margin(s, scale));
+    items.push_back({{s.center - reach, s.center + reach}, s.center, static_cast<std::int32_t>(items.size())});
+  }
+  if (items.empty()) return bvh;
+  bvh.nodes.reserve(2 * items.size());
+  bvh.objects.reserve(items.size());
+  Builder(items, bvh).build(0, static_cast<int>(items.size()), 0);
+  return bvh;
+}
+
+}  // namespace pdflab
