@@ -273,6 +273,57 @@ TEST(Convergence, UnbiasedStrategiesAgreeOnEveryShippedScene) {
 namespace pdflab {
 namespace {
 
+// nee-mis with the light tree converges to the image nee-mis gives with the
+// choice by power: on the many-lights room (16x16, two 8x8 blocks of
+// four, paths of at most three segments: direct light and one bounce, so
+// that both the light sample and the continuation's MIS weight, found from
+// the emitter it reaches, are tested) and, with an environment light, on the
+// sun-and-sky scene with three lamps added (the tree's light density shared
+// with the map's).
+TEST(Convergence, LightTreeAgreesWithPowerChoice) {
+  constexpr int kSide16 = 16;
+  const auto room = [] {
+    auto scene = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/many_lights.json"));
+    scene->camera.width = scene->camera.height = kSide16;
+    scene->max_depth = 3;
+    scene->prepare();
+    return scene;
+  }();
+  const auto sky = [] {
+    const std::string dir = PDFLAB_SOURCE_DIR "/assets/scenes/";
+    std::ifstream in(dir + "sun_sky.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto insert_after = [&](const std::string& key, const std::string& what) {
+      const std::size_t at = text.find(key);
+      EXPECT_NE(at, std::string::npos) << key;
+      if (at != std::string::npos) text.insert(at + key.size(), what);
+    };
+    insert_after("\"materials\": {", R"("lamp": {"type": "diffuse_light", "emit": [30, 24, 18]},)"
+                                      R"("panel": {"type": "diffuse_light", "emit": [3, 3, 4], "two_sided": true},)");
+    insert_after("\"objects\": [", R"({"type": "sphere", "center": [-2.8, 1.2, -1.0], "radius": 0.1, "material": "lamp"},)"
+                                    R"({"type": "sphere", "center": [-0.2, 0.4, -1.6], "radius": 0.15, "material": "lamp"},)"
+                                    R"({"type": "quad", "q": [-0.5, 2.0, -0.5], "u": [1, 0, 0], "v": [0, 0, 1], "material": "panel"},)");
+    auto scene = std::make_shared<Scene>(load_scene_text(text, "sun_sky.json with lamps", dir));
+    scene->camera.width = scene->camera.height = kSide16;
+    scene->max_depth = 3;
+    scene->prepare();
+    return scene;
+  }();
+  const int tests = 2 * (kSide16 / kBlock) * (kSide16 / kBlock) * 3;
+  const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
+  std::uint64_t seed = 950;
+  for (const auto& scene : {room, sky}) {
+    SCOPED_TRACE(scene->name);
+    ASSERT_GE(SamplingPlan::make(Strategy::parse("nee-mis+lights:tree"), *scene).emitters.size(), 3);
+    const BlockImage reference = render_blocks("nee-mis", seed++, 256, scene);
+    const Comparison cmp = compare(render_blocks("nee-mis+lights:tree", seed++, 128, scene), reference);
+    std::printf("[convergence] %-28s nee-mis+lights:tree block z in [%+.2f, %+.2f] (limit %.2f)\n", scene->name.c_str(),
+                cmp.most_negative, cmp.most_positive, limit);
+    for (std::size_t i = 0; i < cmp.z.size(); ++i)
+      EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
+  }
+}
+
 // A shipped scene at 24x24 (the convergence tests' size) with at most `depth` segments a path.
 std::shared_ptr<Scene> small_shipped_scene(const char* file, int depth) {
   auto scene = std::make_shared<Scene>(load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file));

@@ -3,6 +3,7 @@
 // keep the floor, they follow distance and orientation, and the strategy term
 // and scene key that select it.
 #include "renderer/error.h"
+#include "renderer/metrics/probe.h"
 #include "renderer/sampling/light_tree.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/sampling/target_set.h"
@@ -199,6 +200,21 @@ TEST(LightTree, StrategyAndSceneSelectIt) {
   // lit) takes more of the choice than facing up.
   const Vec3 below(3.2f, 1.0f, 3.2f);
   EXPECT_GT(set.probabilities_at(below, Vec3(0, -1, 0)).back(), set.probabilities_at(below, Vec3(0, 1, 0)).back());
+}
+
+// The probe's light choice at a point is the tree's, with the point's normal.
+TEST(LightTree, ProbeShowsTheTreesProbabilities) {
+  const Scene scene = many_lamps_scene("tree");
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("nee-mis"), scene);
+  ProbePoint at;
+  at.found = true;
+  at.point = Vec3(3.2f, 1.0f, 3.2f);
+  at.normal = Vec3(0, -1, 0);
+  const ProbeLightChoice c = probe_light_choice(scene, plan, at);
+  EXPECT_EQ(c.choice, "tree");
+  const std::vector<float> p = plan.emitters.tree->probabilities(at.point, at.normal);
+  ASSERT_EQ(c.rows.size(), p.size());
+  for (std::size_t j = 0; j < p.size(); ++j) EXPECT_EQ(c.rows[j].probability, p[j]) << j;
 }
 
 TEST(LightTree, StrategyTermParsesBack) {
