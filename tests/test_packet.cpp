@@ -209,8 +209,9 @@ TEST(Packet, EnvironmentAndAreaLight) {
 
 // The light tree's choice, made one lane at a time, and its light densities
 // (each emitter's own, found from the one a continuation reaches): on the
-// many-lights room and on the sun-and-sky scene with two lamps (the map's
-// share beside the tree's), the packet tracer gives the one-path tracer's bits.
+// many-lights room, on the sun-and-sky scene with two lamps (the map's
+// share beside the tree's) and on the frosted box with a second lamp, the
+// packet tracer gives the one-path tracer's bits.
 TEST(Packet, LightTree) {
   const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
   std::ifstream in(dir + "/sun_sky.json");
@@ -229,7 +230,17 @@ TEST(Packet, LightTree) {
   sky.prepare();
   Scene room = small_scene("many_lights.json", 16, 12);
   room.max_depth = 4;
-  for (const Scene* scene : {&room, &sky})
+  // The frosted box with a second lamp: the tree's choice without the normal
+  // at the rough dielectric, its continuations' densities from the vertex they left.
+  std::ifstream frosted_in(dir + "/frosted_glass.json");
+  text.assign((std::istreambuf_iterator<char>(frosted_in)), std::istreambuf_iterator<char>());
+  put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [15, 15, 15] },)");
+  put("\"objects\": [", R"( { "type": "sphere", "center": [400, 60, 120], "radius": 20, "material": "lamp" },)");
+  Scene frosted = load_scene_text(text, "frosted_glass.json", dir);
+  frosted.camera.width = 24;
+  frosted.camera.height = 20;
+  frosted.prepare();
+  for (const Scene* scene : {&room, &sky, &frosted})
     for (const char* strategy : {"nee-mis+lights:tree", "nee-mis+mix:cosine=0.5,light-sa=0.5+sobol+rr:2+lights:tree"}) {
       const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), *scene);
       ASSERT_NE(plan.emitters.tree, nullptr);
