@@ -106,7 +106,7 @@ TEST(LightTree, ChoiceRealisesExactlyItsProbabilities) {
 TEST(LightTree, ProbabilitiesSumToOneAndKeepTheFloor) {
   for (const int n : {2, 3, 300}) {
     const LightTree tree(scattered(n, 7 + static_cast<std::uint64_t>(n)), kLightChoiceFloor);
-    EXPECT_LE(tree.depth(), static_cast<int>(std::ceil(std::log2(n)))) << n;
+    EXPECT_LE(tree.depth(), 64) << n;  // a path fits its bits
     pcg32 rng(11);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     for (int k = 0; k < 100; ++k) {

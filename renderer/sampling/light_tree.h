@@ -89,6 +89,7 @@ class LightTree {
   std::vector<std::uint8_t> path_length_;
   int count_ = 0;
   std::uint32_t floor_count_ = 0;  // numbers per emitter in the uniform floor
+  int median_from_ = 0;  // the depth from which nodes split at the median (a path fits 64 bits)
 };
 
 }  // namespace pdflab
