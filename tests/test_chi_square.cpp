@@ -62,6 +62,7 @@ enum class Targets {
   BookLight,       // the book's light quad alone (scene scale ~500)
   Book,            // the book's scene: its light and its glass sphere
   TwoPowers,       // two emitting quads overhead, one 40x the other's power
+  ManyLamps,       // four small quads overhead (one facing up) and two spheres, of powers over a factor 50
   TwoLightsScene,  // assets/scenes/two_lights.json: a tiny bright light and a wide dim one
   GlossyScene,     // assets/scenes/glossy_metal.json: a metal box (six quads) and a metal sphere
   // No targets; environment maps other than the sky every other scene has:
@@ -154,6 +155,28 @@ std::unique_ptr<Scene> make_scene(Targets which) {
       add_quad_target(*s, {-1.2f, 1, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f});
       add_quad_target(*s, {0.6f, 1, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f});
       s->quads[1].material = 1;
+      break;
+    }
+    case Targets::ManyLamps: {
+      Material lamp;
+      lamp.type = MaterialType::DiffuseLight;
+      s->materials.clear();
+      s->material_names.clear();
+      for (const float emit : {1.0f, 5.0f, 50.0f}) {
+        lamp.emit = Vec3(emit);
+        s->materials.push_back(lamp);
+        s->material_names.push_back("lamp" + std::to_string(s->materials.size()));
+      }
+      for (int i = 0; i < 4; ++i) {
+        const float x = -1.2f + 1.4f * static_cast<float>(i % 2), z = -1.2f + 1.4f * static_cast<float>(i / 2);
+        if (i == 3) add_quad_target(*s, {x, 1.3f, z}, {0, 0, 0.4f}, {0.4f, 0, 0});  // faces up: lights nothing below
+        else add_quad_target(*s, {x, 1.0f + 0.1f * static_cast<float>(i % 2), z}, {0.4f, 0, 0}, {0, 0, 0.4f});
+        s->quads.back().material = static_cast<std::uint32_t>(i % 3);
+      }
+      for (int i = 0; i < 2; ++i) {
+        add_sphere_target(*s, {-1.0f + 0.7f * static_cast<float>(i), 0.7f, 1.3f - 0.6f * static_cast<float>(i % 2)}, 0.12f);
+        s->spheres.back().material = static_cast<std::uint32_t>((i + 1) % 3);
+      }
       break;
     }
     case Targets::Book:
@@ -270,6 +293,10 @@ const std::vector<ChiCase>& chi_cases() {
       {"nee_emitters_two_powers_close", "nee-mis", Targets::TwoPowers, {0, 0.9f, 0}, {0, 1, 0}, true},
       {"nee_emitters_two_powers_one_flat", "nee-mis", Targets::TwoPowers, {-0.9f, 0.8f, 0}, {0, 1, 0}, true},
       {"nee_emitters_book_close_to_the_light", "nee-mis", Targets::Book, {300, 500, 250}, {0, 1, 0}, true},
+      // Chosen by the light tree (each emitter's probability from the point,
+      // the set's density their sum), among lamps facing either way.
+      {"nee_emitters_tree_many_lamps_among_them", "nee-mis+lights:tree", Targets::ManyLamps, {0.3f, 0.9f, 0.8f},
+       {0, 1, 0}, true},
       // The environment map's 2D distribution: a sun inside one texel, a
       // black half (its pdf zero there), a constant map (uniform over the sphere).
       {"environment_sub_texel_sun", "environment", Targets::SubTexelSun, {0, 0, 0}, {0, 1, 0}},

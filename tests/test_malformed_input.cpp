@@ -228,6 +228,8 @@ const std::map<std::string, std::string> kSceneFileNeedles = {
     {"huge_coordinate.json", "objects[1].center[1]: magnitude is too large"},
     {"image_16384_square.json", "camera: image size 16384x16384 has 268435456 pixels, more than the limit"},
     {"infinity_literal.json", "JSON syntax error at line 3"},
+    {"light_choice_unknown.json", "light_choice: unknown light choice 'nearest' (allowed: power, uniform, tree)"},
+    {"light_choice_wrong_type.json", "light_choice: expected a string, found number"},
     {"max_depth_zero.json", "camera.max_depth: must be in 1..10000, found 0"},
     {"metal_fuzz_above_one.json", "materials.white.fuzz: must be in 0..1"},
     {"missing_camera.json", "top level: missing key 'camera'"},

@@ -53,7 +53,8 @@ const char* const kStrategies[] = {"mix:cosine=0.5,light=0.5",
                                    "light-sa+sobol",
                                    "mix:cosine=0.6,specular-objects=0.4",
                                    "nee-mis+mix:cosine=0.8,specular-objects=0.2+sobol+rr:3",
-                                   "nee-mis+mix:cosine=0.4,light=0.3,specular-objects=0.3"};
+                                   "nee-mis+mix:cosine=0.4,light=0.3,specular-objects=0.3",
+                                   "nee-mis+lights:tree"};
 
 Scene small_scene(const std::string& file, int width, int height) {
   Scene scene = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);
@@ -244,6 +245,51 @@ TEST(Packet, TheTreeOverObjectsGivesTheFlatLoopsBits) {
   }
   // Thousands of samples found light (nee-mis's light samples): no comparison of black images.
   EXPECT_GE(nonzero, samples / 3);
+
+// The light tree's choice, made one lane at a time, and its light densities
+// (each emitter's own, found from the one a continuation reaches): on the
+// many-lights room, on the sun-and-sky scene with two lamps (the map's
+// share beside the tree's) and on the frosted box with a second lamp, the
+// packet tracer gives the one-path tracer's bits.
+TEST(Packet, LightTree) {
+  const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
+  std::ifstream in(dir + "/sun_sky.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto put = [&](const std::string& after, const std::string& what) {
+    const std::size_t at = text.find(after);
+    ASSERT_NE(at, std::string::npos) << after;
+    text.insert(at + after.size(), what);
+  };
+  put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [40, 30, 20] },)");
+  put("\"objects\": [", R"( { "type": "quad", "q": [-2.5, 2.6, -1.2], "u": [0.6, 0, 0], "v": [0, 0, 0.6], "material": "lamp" },)"
+                         R"( { "type": "sphere", "center": [-0.2, 0.4, -1.6], "radius": 0.15, "material": "lamp" },)");
+  Scene sky = load_scene_text(text, "sun_sky.json", dir);
+  sky.camera.width = 24;
+  sky.camera.height = 20;
+  sky.prepare();
+  Scene room = small_scene("many_lights.json", 16, 12);
+  room.max_depth = 4;
+  // The frosted box with a second lamp: the tree's choice without the normal
+  // at the rough dielectric, its continuations' densities from the vertex they left.
+  std::ifstream frosted_in(dir + "/frosted_glass.json");
+  text.assign((std::istreambuf_iterator<char>(frosted_in)), std::istreambuf_iterator<char>());
+  put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [15, 15, 15] },)");
+  put("\"objects\": [", R"( { "type": "sphere", "center": [400, 60, 120], "radius": 20, "material": "lamp" },)");
+  Scene frosted = load_scene_text(text, "frosted_glass.json", dir);
+  frosted.camera.width = 24;
+  frosted.camera.height = 20;
+  frosted.prepare();
+  for (const Scene* scene : {&room, &sky, &frosted})
+    for (const char* strategy : {"nee-mis+lights:tree", "nee-mis+mix:cosine=0.5,light-sa=0.5+sobol+rr:2+lights:tree"}) {
+      const SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), *scene);
+      ASSERT_NE(plan.emitters.tree, nullptr);
+      for (PacketIsa isa : available_packet_isas()) {
+        const Comparison c = compare(isa, *scene, plan, 5, SampleBlock{0, 0, scene->camera.width, scene->camera.height, 0, 2});
+        EXPECT_EQ(c.differing, 0u) << scene->name << ", " << strategy << ", " << packet_isa_name(isa) << ": "
+                                   << c.first_difference;
+        EXPECT_GE(c.nonzero, 300u) << scene->name;
+      }
+    }
 }
 
 // The instruction sets: the baseline always, narrowest first, each wider than

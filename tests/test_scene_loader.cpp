@@ -565,7 +565,7 @@ TEST(SceneValidation, DuplicateKeysAreRefusedWithTheirPath) {
 // a C string once made into the exception); it shows as \x00 with the rest.
 TEST(SceneValidation, ANulInAKeyIsShownNotCut) {
   const std::string message = load_error(R"({"cam\u0000era": 1, "camera": {}})");
-  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, environment, materials, name, objects)"),
+  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, environment, light_choice, materials, name, objects)"),
             std::string::npos)
       << message;
 }

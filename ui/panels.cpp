@@ -370,6 +370,16 @@ void path_options(SamplingSettings& s) {
     ImGui::SetTooltip("Owen-scrambled Sobol points for %s random numbers, stratified\n"
                       "across each pixel's samples (+sobol); off: every number independent",
                       stratified_vertices().c_str());
+  if (!s.nee_mis) return;
+  // nee-mis's light choice: the scene's (its light_choice), or one of LightChoice's.
+  const char* items[] = {"the scene's", "power", "uniform", "tree"};
+  int current = s.light_choice ? 1 + static_cast<int>(*s.light_choice) : 0;
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+  if (ImGui::Combo("light choice", &current, items, 4))
+    s.light_choice = current == 0 ? std::nullopt : std::optional<LightChoice>(static_cast<LightChoice>(current - 1));
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("How nee-mis chooses the emitter of its light sample (+lights:CHOICE): by power, uniformly,\n"
+                      "or by the light tree (power, distance and orientation from the point, for many lights)");
 }
 
 // The strategy as `pdflab render --strategy` takes it, wrapped before a '+'

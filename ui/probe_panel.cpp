@@ -201,18 +201,28 @@ void chi_square_section(ProbeState& s, double now) {
   plot.legend({{"observed", IM_COL32(90, 170, 255, 200)}, {"expected", IM_COL32(255, 190, 60, 255)}});
 }
 
-// Each light's probability of being chosen at the point, beside its share by power.
+// Each light's probability of being chosen at the point, beside its share by
+// power; of many lights, the kShownLights most likely here.
 void light_choice_section(const ProbeState& s) {
+  constexpr std::size_t kShownLights = 12;
   const ProbeLightChoice& c = s.light_choice;
   if (c.rows.size() < 2) return;
   ImGui::Separator();
-  ImGui::Text("Light choice here (%s)", c.set.c_str());
+  ImGui::Text("Light choice here (%s, by %s)", c.set.c_str(), c.choice.c_str());
+  std::vector<std::size_t> order(c.rows.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return c.rows[a].probability > c.rows[b].probability; });
+  const std::size_t shown = std::min(order.size(), kShownLights);
   if (!ImGui::BeginTable("light choice", 3, ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_RowBg)) return;
   ImGui::TableSetupColumn("light");
   ImGui::TableSetupColumn("by power");
   ImGui::TableSetupColumn("at this point");
   ImGui::TableHeadersRow();
-  for (const ProbeLightChoice::Row& r : c.rows) {
+  double rest = 1.0;
+  for (std::size_t k = 0; k < shown; ++k) {
+    const ProbeLightChoice::Row& r = c.rows[order[k]];
+    rest -= r.probability;
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
     ImGui::TextUnformatted(r.label.c_str());
@@ -223,7 +233,14 @@ void light_choice_section(const ProbeState& s) {
     else ImGui::TextColored(kAmber, "%.3g  (behind it)", r.probability);
   }
   ImGui::EndTable();
-  ImGui::TextColored(kDim, "by what the point receives, %g%% of the choices uniform", 100.0 * kLightChoiceFloor);
+  if (shown < order.size())
+    ImGui::TextColored(kDim, "the %zu lights most likely here of %zu; the other %zu take %.3g%% of the choices", shown,
+                       order.size(), order.size() - shown, 100.0 * std::max(rest, 0.0));
+  if (c.choice == "tree")
+    ImGui::TextColored(kDim, "by the light tree (power, distance, orientation, the normal), %g%% of the choices uniform",
+                       100.0 * kLightChoiceFloor);
+  else
+    ImGui::TextColored(kDim, "by what the point receives, %g%% of the choices uniform", 100.0 * kLightChoiceFloor);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@ Strategy SamplingSettings::strategy() const {
   if (nee_mis) {
     s = Strategy::nee(heuristic);
     s.weights = continuation;
+    s.light_choice = light_choice;
   }
   s.parameters = parameters;
   s.roulette_depth = roulette_depth;
@@ -36,6 +37,7 @@ SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   out.roulette_depth = strategy.roulette_depth;
   out.sobol = strategy.sobol;
   out.fastest = strategy.fastest;
+  out.light_choice = strategy.light_choice;
   if (strategy.nee_mis) {
     out.nee_mis = true;
     out.heuristic = strategy.heuristic;

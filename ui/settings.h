@@ -6,6 +6,7 @@
 #include "ui/measure.h"
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +32,8 @@ struct SamplingSettings {
   int roulette_depth = 0;  // Strategy::roulette_depth, for any of the above
   bool sobol = false;      // Strategy::sobol (the stratified sampler), for any of the above
   bool fastest = false;    // the `fastest` preset, as it expands
+  // nee-mis's light choice (Strategy::light_choice; none: the scene's).
+  std::optional<LightChoice> light_choice;
 
   Strategy strategy() const;
   Strategy strategy_without_name() const;  // as strategy(), never marked `fastest`

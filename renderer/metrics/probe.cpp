@@ -211,14 +211,15 @@ ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan
   ProbeLightChoice out;
   const TargetSet* set = nullptr;
   if (plan.nee_mis) {
-    set = &plan.emitters, out.set = "nee-mis emitters";
+    set = &plan.emitters, out.set = "nee-mis emitters", out.choice = light_choice_name(plan.light_choice);
   } else if (plan.weight[static_cast<int>(Technique::LightSolidAngle)] > 0.0f) {
-    set = &plan.power_targets, out.set = "light-sa targets";
+    set = &plan.power_targets, out.set = "light-sa targets", out.choice = "power";
   } else if (plan.weight[static_cast<int>(Technique::Light)] > 0.0f) {
-    set = &plan.book_targets, out.set = "light targets";
+    set = &plan.book_targets, out.set = "light targets", out.choice = "uniform";
   }
   if (!set || !at.found || set->empty()) return out;
-  const std::vector<float> p = set->probabilities_at(at.point);
+  // A light tree reads the point's normal too, as the light sample there does.
+  const std::vector<float> p = set->probabilities_at(at.point, set->tree ? at.normal : Vec3(0.0f));
   int j = 0;
   for (const TargetSet::QuadEntry& e : set->quads) {
     out.rows.push_back({target_label(scene, e.quad->material, "quad"), e.probability, p[static_cast<std::size_t>(j)],

@@ -77,6 +77,9 @@ void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, flo
 // (nee-mis: its emitters; else light-sa's targets, else light's), quads first.
 struct ProbeLightChoice {
   std::string set;  // "nee-mis emitters", "light-sa targets" or "light targets"
+  // How the set chooses (nee-mis: LightChoice's name, "power", "uniform" or
+  // "tree"; the others: "power" or "uniform").
+  std::string choice;
   struct Row {
     std::string label;  // the material's name and the shape, e.g. "light (quad)"
     float share = 0.0f;        // its share of the choice by power (the set's own)

@@ -74,7 +74,7 @@ DiscreteDistribution technique_choice(const Strategy& strategy, const std::array
 void SamplingPlan::bind_targets() {
   book_targets = book_target_set(*scene);
   power_targets = power_target_set(*scene);
-  emitters = emitter_set(*scene);
+  emitters = emitter_set(*scene, light_choice);
   specular_objects = specular_object_set(*scene);
   environment = scene->environment && scene->environment->sampleable() ? scene->environment.get() : nullptr;
   environment_share = environment_light_share(*scene);
@@ -118,6 +118,7 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.heuristic = strategy.heuristic;
   plan.roulette_depth = strategy.roulette_depth;
   plan.sobol = strategy.sobol;
+  plan.light_choice = strategy.light_choice.value_or(scene.light_choice);
   plan.bind_targets();
   plan.set_technique_choice(strategy);
   return plan;

@@ -171,7 +171,7 @@ std::string technique_table_markdown() {
 
 std::string strategy_help() {
   std::string out =
-      "Strategies: BASE[+sobol][+rr[:D]] | fastest[+sobol][+rr[:D]]\n"
+      "Strategies: BASE[+sobol][+rr[:D]][+lights:CHOICE] | fastest[+sobol][+rr[:D]][+lights:CHOICE]\n"
       "  BASE := MIXTURE | nee-mis[:balance][+MIXTURE]\n"
       "  MIXTURE := TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...]\n"
       "  nee-mis: a light sample and a continuation at each diffuse vertex, weighed by MIS (power heuristic,\n"
@@ -187,6 +187,8 @@ std::string strategy_help() {
       " draws (continuation, light sample, specular bounce) from Owen-scrambled Sobol points\n"
       "    stratified across a pixel's samples, the rest from the sample's random stream (unbiased;\n"
       "    off by default: every draw independent)\n"
+      "  +lights:CHOICE (nee-mis): how the light sample's emitter is chosen: power (the default, or the scene's\n"
+      "    light_choice), uniform, or tree (a light tree: power, distance and orientation from the point)\n"
       "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +
       "\nTechniques:\n";
   for (const TechniqueInfo& t : kTable) {
@@ -288,11 +290,17 @@ Strategy Strategy::parse(std::string_view text) {
   // turn on Russian roulette.
   int roulette = 0;
   bool sobol = false;
+  std::optional<LightChoice> lights;
   for (;;) {
     const std::size_t last_plus = body.rfind('+');
     if (last_plus == std::string_view::npos) break;
     const std::string_view term = trim(body.substr(last_plus + 1));
-    if (term.substr(0, 2) == "rr" && !roulette) {
+    if (term.substr(0, 7) == "lights:" && !lights) {
+      LightChoice c;
+      if (!parse_light_choice(trim(term.substr(7)), c))
+        throw InputError("strategy '" + std::string(whole) + "': the light choice must be 'power', 'uniform' or 'tree'");
+      lights = c;
+    } else if (term.substr(0, 2) == "rr" && !roulette) {
       roulette = parse_roulette(term, whole);
     } else if (term == "sobol" && !sobol) {
       sobol = true;
@@ -307,6 +315,7 @@ Strategy Strategy::parse(std::string_view text) {
     s.fastest = true;
     if (roulette) s.roulette_depth = roulette;
     if (sobol) s.sobol = true;
+    s.light_choice = lights;
     return s;
   }
   if (body.substr(0, 7) == "nee-mis") {
@@ -328,8 +337,11 @@ Strategy Strategy::parse(std::string_view text) {
   } else {
     s = parse_mixture(body, whole);
   }
+  if (lights && !s.nee_mis)
+    throw InputError("strategy '" + std::string(whole) + "': +lights chooses nee-mis's light sample; the strategy has none");
   s.roulette_depth = roulette;
   s.sobol = sobol;
+  s.light_choice = lights;
   return s;
 }
 
@@ -352,6 +364,7 @@ std::string Strategy::to_string() const {
     out.append("+rr");
     if (roulette_depth != kDefaultRouletteDepth) out.append(":").append(std::to_string(roulette_depth));
   }
+  if (light_choice) out.append("+lights:").append(light_choice_name(*light_choice));
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include "renderer/scene/scene.h"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -88,6 +89,9 @@ struct Strategy {
   // other draw from the sample's pcg stream as before (off: the independent
   // sampler, every draw from the stream). Unbiased either way.
   bool sobol = false;
+  // `+lights:NAME` (nee-mis only): how the light sample's emitter is chosen
+  // (LightChoice: power, uniform or tree); none: the scene's (Scene::light_choice).
+  std::optional<LightChoice> light_choice;
   // Parsed from `fastest`: the fields above are what it expanded to
   // (kFastestStrategy), which to_string gives; sidecars record both.
   bool fastest = false;
@@ -166,7 +170,8 @@ struct SamplingPlan {
 
   TargetSet book_targets;   // `light`: the importance targets, chosen uniformly
   TargetSet power_targets;  // `light-sa`: the importance targets, emitters by power
-  TargetSet emitters;       // `nee-mis`: every emitter, by power
+  TargetSet emitters;       // `nee-mis`: every emitter, chosen by light_choice
+  LightChoice light_choice = LightChoice::Power;  // the strategy's, else the scene's
   TargetSet specular_objects;  // `specular-objects`: the glass and metal objects, chosen uniformly
   // The scene's environment light where it has light (`environment`'s map;
   // null: none), and the probability that nee-mis's light sample samples it

@@ -57,7 +57,8 @@ void TargetSet::set_probabilities(const std::vector<double>& weights) {
 
 bool TargetSet::receives(const Vec3& origin, int j) const { return leaf::receives_light(*this, j, origin); }
 
-std::vector<float> TargetSet::probabilities_at(const Vec3& origin) const {
+std::vector<float> TargetSet::probabilities_at(const Vec3& origin, const Vec3& normal) const {
+  if (tree) return tree->probabilities(origin, normal);
   std::vector<float> out;
   out.reserve(static_cast<std::size_t>(size()));
   if (!by_point) {
@@ -71,6 +72,7 @@ std::vector<float> TargetSet::probabilities_at(const Vec3& origin) const {
 }
 
 std::uint32_t TargetSet::first_choice_of(const Vec3& origin, int j) const {
+  if (tree) return tree->first_choice_of(j);
   if (j <= 0) return 0u;
   if (!by_point) return choice.thresholds()[static_cast<std::size_t>(j - 1)];
   double below = 0.0;  // C_{j-1}: the probabilities are multiples of 2^-24, so the sum is exact
@@ -209,12 +211,56 @@ TargetSet power_target_set(const Scene& scene) {
   return set;
 }
 
-TargetSet emitter_set(const Scene& scene) {
+namespace {
+
+// The tree over a set's emitters (quads, then spheres), each with its power.
+std::shared_ptr<const LightTree> light_tree(const TargetSet& set, const std::vector<double>& power) {
+  std::vector<LightTree::Emitter> emitters;
+  std::size_t k = 0;
+  for (const TargetSet::QuadEntry& e : set.quads) {
+    const Quad& q = *e.quad;
+    LightTree::Emitter x;
+    x.lo = glm::min(glm::min(q.q, q.q + q.u), glm::min(q.q + q.v, q.q + q.u + q.v));
+    x.hi = glm::max(glm::max(q.q, q.q + q.u), glm::max(q.q + q.v, q.q + q.u + q.v));
+    x.axis = q.normal;
+    x.cos_spread = 1.0f;
+    x.two_sided = !e.axes.one_sided;
+    x.power = static_cast<float>(power[k++]);
+    emitters.push_back(x);
+  }
+  for (const TargetSet::SphereEntry& e : set.spheres) {
+    const Sphere& sp = *e.sphere;
+    LightTree::Emitter x;
+    x.lo = sp.center - Vec3(sp.radius);
+    x.hi = sp.center + Vec3(sp.radius);
+    x.axis = Vec3(0.0f, 0.0f, 1.0f);
+    x.cos_spread = -1.0f;
+    x.power = static_cast<float>(power[k++]);
+    emitters.push_back(x);
+  }
+  return std::make_shared<const LightTree>(emitters, kLightChoiceFloor);
+}
+
+}  // namespace
+
+TargetSet emitter_set(const Scene& scene, LightChoice light_choice) {
   TargetSet set;
-  const std::vector<double> power = collect_targets(scene, set, [&](const Target& t) { return is_emitter(scene, t); });
+  std::vector<double> power = collect_targets(scene, set, [&](const Target& t) { return is_emitter(scene, t); });
   for (TargetSet::QuadEntry& e : set.quads) e.axes.flat_distance_ratio = kEmitterFlatDistanceRatio;
   set.solid_angle = true;
-  set.set_probabilities(power_weights(power));
+  power = power_weights(power);
+  if (light_choice == LightChoice::Uniform) std::fill(power.begin(), power.end(), 1.0);
+  set.set_probabilities(power);
+  if (light_choice == LightChoice::Tree && set.size() >= 2) {
+    set.tree = light_tree(set, power);
+    set.by_point = false;  // the tree reads the point
+    set.target_of.assign(scene.quads.size() + scene.spheres.size(), -1);
+    for (int j = 0; j < set.size(); ++j) {
+      const int nq = static_cast<int>(set.quads.size());
+      const std::int32_t id = j < nq ? set.quads[static_cast<std::size_t>(j)].index : set.spheres[static_cast<std::size_t>(j - nq)].index;
+      set.target_of[static_cast<std::size_t>(id)] = j;
+    }
+  }
   return set;
 }
 

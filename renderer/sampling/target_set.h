@@ -3,13 +3,16 @@
 // probability of choosing each, and the three sets a sampling plan keeps.
 #include "renderer/math.h"
 #include "renderer/sampling/discrete.h"
+#include "renderer/sampling/light_tree.h"
 #include "renderer/sampling/techniques.h"
 #include "renderer/scene/scene.h"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace pdflab {
+
 
 // Importance targets with the probability of choosing each, split by kind so
 // that evaluating their pdf needs no per-target switch.
@@ -56,6 +59,16 @@ struct TargetSet {
   // share wherever the point is; empty: all do), and the emitters' total share.
   std::vector<unsigned char> emits;
   float emitter_share = 1.0f;
+  // The light tree that chooses the target from each point (LightChoice::Tree;
+  // null: `choice`, or by_point). With it the integrator weighs a light sample
+  // by the density of the emitter it reaches alone (probability of choosing
+  // that emitter times its own density), so that neither the sample nor the
+  // density of a continuation that finds an emitter visits the others; `pdf`
+  // and `sample` still give the set's whole density (the sum), for the tests.
+  std::shared_ptr<const LightTree> tree;
+  // With a tree: each scene object's index in the set (Scene::quads, then
+  // Scene::spheres, the ids a hit carries), -1 for those not in it.
+  std::vector<std::int32_t> target_of;
 
   bool empty() const { return quads.empty() && spheres.empty(); }
   int size() const { return static_cast<int>(quads.size() + spheres.size()); }
@@ -74,8 +87,9 @@ struct TargetSet {
   // term holds even for a sliver float's intersection test would miss.
   float pdf(const Vec3& origin, const Vec3& direction, int aimed_quad = -1, float aimed_t = 0.0f) const;
   // The probability of choosing each target (quads, then spheres) from `origin`:
-  // `probability` itself unless by_point.
-  std::vector<float> probabilities_at(const Vec3& origin) const;
+  // `probability` itself unless by_point or by a tree (whose choice also reads
+  // the point's normal, facing where light arrives from; zero: none).
+  std::vector<float> probabilities_at(const Vec3& origin, const Vec3& normal = Vec3(0.0f)) const;
   // The smallest 32-bit u_choice that chooses target j from `origin` (its
   // probability there must be positive).
   std::uint32_t first_choice_of(const Vec3& origin, int j) const;
@@ -109,7 +123,8 @@ TargetSet power_target_set(const Scene& scene);
 // spherical rectangle took (below float's domain, it took the double form); the
 // large light loses 8% (its floor sees it flat, where solid angle did better).
 inline constexpr float kEmitterFlatDistanceRatio = 2.0f;
-TargetSet emitter_set(const Scene& scene);
+// `choice`: how the emitter is chosen (LightChoice; Power is the above).
+TargetSet emitter_set(const Scene& scene, LightChoice choice = LightChoice::Power);
 // `specular-objects`'s: every quad and sphere of glass or metal, chosen
 // uniformly, quads by area (what carries caustics and light seen in mirrors,
 // which a light sample cannot reach through).

@@ -8,6 +8,7 @@
 #include <memory>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pdflab {
@@ -136,6 +137,24 @@ inline constexpr double kCameraCentredRatio = 64.0;
 // more than 1/64 of the box).
 inline constexpr double kSmallestBoxSteps = 64.0;
 
+// How nee-mis chooses the emitter of its light sample: in proportion to power
+// (and to what the point receives: TargetSet::by_point), uniformly (with the
+// same reweighting), or by the light tree (LightTree: power, distance and
+// orientation, in time logarithmic in the emitters). Written as in a scene
+// file's `light_choice` and a strategy's `+lights:NAME`.
+enum class LightChoice : std::uint8_t { Power, Uniform, Tree };
+inline constexpr std::string_view kLightChoiceNames[] = {"power", "uniform", "tree"};
+inline std::string_view light_choice_name(LightChoice c) { return kLightChoiceNames[static_cast<int>(c)]; }
+// The choice a name gives; false where it names none.
+inline bool parse_light_choice(std::string_view name, LightChoice& out) {
+  for (int i = 0; i < 3; ++i)
+    if (name == kLightChoiceNames[i]) {
+      out = static_cast<LightChoice>(i);
+      return true;
+    }
+  return false;
+}
+
 struct Scene {
   std::string name;
   // Of the scene file's content without the image size, the depth and the
@@ -145,6 +164,9 @@ struct Scene {
   Camera camera;
   int max_depth = 50;
   Vec3 background{0.0f};
+  // How nee-mis chooses its light sample's emitter where the strategy does not
+  // say (the scene file's `light_choice`).
+  LightChoice light_choice = LightChoice::Power;
   // The environment light (scene file's `environment`): the radiance of a ray
   // that leaves the scene, in place of `background`; null: none.
   std::shared_ptr<const Environment> environment;

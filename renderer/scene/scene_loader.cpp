@@ -556,11 +556,16 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
                      ": the key appears twice in its object (JSON would keep only the last value)");
   Node root(doc, "", origin);
   root.expect_object();
-  root.allow_only({"name", "description", "camera", "materials", "objects", "environment"});
+  root.allow_only({"name", "description", "camera", "materials", "objects", "environment", "light_choice"});
 
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : origin;
   if (root.has("description")) (void)root.child("description").string();
+  if (root.has("light_choice")) {
+    const Node choice = root.child("light_choice");
+    if (!parse_light_choice(choice.string(), scene.light_choice))
+      choice.fail("unknown light choice '" + choice.string() + "' (allowed: power, uniform, tree)");
+  }
   Placement placement;
   parse_camera(root.require("camera"), scene, placement);
 
