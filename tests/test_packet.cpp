@@ -245,6 +245,7 @@ TEST(Packet, TheTreeOverObjectsGivesTheFlatLoopsBits) {
   }
   // Thousands of samples found light (nee-mis's light samples): no comparison of black images.
   EXPECT_GE(nonzero, samples / 3);
+}
 
 // The light tree's choice, made one lane at a time, and its light densities
 // (each emitter's own, found from the one a continuation reaches): on the
