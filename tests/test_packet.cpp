@@ -177,18 +177,26 @@ TEST(Packet, DepthLimitsAndDropsAsTheScalarTracer) {
   }
 }
 
+// A shipped scene's text, to be edited (insert_after) before it is loaded.
+std::string shipped_scene_text(const std::string& name) {
+  std::ifstream in(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + name);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// `what` inserted just after the first `after` in `text`, which must hold it.
+void insert_after(std::string& text, const std::string& after, const std::string& what) {
+  const std::size_t at = text.find(after);
+  ASSERT_NE(at, std::string::npos) << after;
+  text.insert(at + after.size(), what);
+}
+
 // nee-mis's light sample choosing between an environment map and an area
 // light (environment_light_share), and every strategy's misses reading the
 // map: the packet tracer gives the one-path tracer's bits.
 TEST(Packet, EnvironmentAndAreaLight) {
   const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
-  std::ifstream in(dir + "/sun_sky.json");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto put = [&](const std::string& after, const std::string& what) {
-    const std::size_t at = text.find(after);
-    ASSERT_NE(at, std::string::npos) << after;
-    text.insert(at + after.size(), what);
-  };
+  std::string text = shipped_scene_text("sun_sky.json");
+  const auto put = [&](const std::string& after, const std::string& what) { insert_after(text, after, what); };
   put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [40, 30, 20] },)");
   put("\"objects\": [", R"( { "type": "quad", "q": [-2.5, 2.6, -1.2], "u": [0.6, 0, 0], "v": [0, 0, 0.6], "material": "lamp" },)");
   Scene scene = load_scene_text(text, "sun_sky.json", dir);
@@ -254,13 +262,8 @@ TEST(Packet, TheTreeOverObjectsGivesTheFlatLoopsBits) {
 // packet tracer gives the one-path tracer's bits.
 TEST(Packet, LightTree) {
   const std::string dir = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes";
-  std::ifstream in(dir + "/sun_sky.json");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto put = [&](const std::string& after, const std::string& what) {
-    const std::size_t at = text.find(after);
-    ASSERT_NE(at, std::string::npos) << after;
-    text.insert(at + after.size(), what);
-  };
+  std::string text = shipped_scene_text("sun_sky.json");
+  const auto put = [&](const std::string& after, const std::string& what) { insert_after(text, after, what); };
   put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [40, 30, 20] },)");
   put("\"objects\": [", R"( { "type": "quad", "q": [-2.5, 2.6, -1.2], "u": [0.6, 0, 0], "v": [0, 0, 0.6], "material": "lamp" },)"
                          R"( { "type": "sphere", "center": [-0.2, 0.4, -1.6], "radius": 0.15, "material": "lamp" },)");
@@ -272,8 +275,7 @@ TEST(Packet, LightTree) {
   room.max_depth = 4;
   // The frosted box with a second lamp: the tree's choice without the normal
   // at the rough dielectric, its continuations' densities from the vertex they left.
-  std::ifstream frosted_in(dir + "/frosted_glass.json");
-  text.assign((std::istreambuf_iterator<char>(frosted_in)), std::istreambuf_iterator<char>());
+  text = shipped_scene_text("frosted_glass.json");
   put("\"materials\": {", R"( "lamp": { "type": "diffuse_light", "emit": [15, 15, 15] },)");
   put("\"objects\": [", R"( { "type": "sphere", "center": [400, 60, 120], "radius": 20, "material": "lamp" },)");
   Scene frosted = load_scene_text(text, "frosted_glass.json", dir);
