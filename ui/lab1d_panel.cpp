@@ -241,19 +241,8 @@ void draw_lab1d_window(Lab1dState& s, bool* open, float area_width, float area_h
   // set when it opens and whenever the window or the scale changes.
   (void)area_width;
   (void)area_height;
-  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (!draw::begin_lab_window("1D lab: Monte Carlo on [0, 2] (L)", open, s.sized_for, 64.0f, 48.0f)) return;
   const float font = ImGui::GetFontSize();
-  const float w = std::max(300.0f, std::min(display.x - 20.0f, font * 64.0f));
-  const float h = std::max(300.0f, std::min(display.y - 20.0f, font * 48.0f));
-  const bool resized = s.sized_for[0] != display.x || s.sized_for[1] != display.y || s.sized_for[2] != font;
-  s.sized_for = {display.x, display.y, font};
-  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
-  ImGui::SetNextWindowSize(ImVec2(w, h), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
-  ImGui::SetNextWindowBgAlpha(0.97f);
-  if (!ImGui::Begin("1D lab: Monte Carlo on [0, 2] (L)", open, ImGuiWindowFlags_NoSavedSettings)) {
-    ImGui::End();
-    return;
-  }
   if (s.running) s.step(s.samples_per_frame);
 
   lab::Integrand f = s.integrand;

@@ -376,19 +376,8 @@ void resolution_table(Lab2dState& s) {
 
 void draw_lab2d_window(Lab2dState& s, bool* open) {
   // Sized as the 1D lab: follows the window and the UI scale.
-  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (!draw::begin_lab_window("2D lab: sampling an environment map (D)", open, s.sized_for, 72.0f, 56.0f)) return;
   const float font = ImGui::GetFontSize();
-  const float w = std::max(300.0f, std::min(display.x - 20.0f, font * 72.0f));
-  const float h = std::max(300.0f, std::min(display.y - 20.0f, font * 56.0f));
-  const bool resized = s.sized_for[0] != display.x || s.sized_for[1] != display.y || s.sized_for[2] != font;
-  s.sized_for = {display.x, display.y, font};
-  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
-  ImGui::SetNextWindowSize(ImVec2(w, h), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
-  ImGui::SetNextWindowBgAlpha(0.97f);
-  if (!ImGui::Begin("2D lab: sampling an environment map (D)", open, ImGuiWindowFlags_NoSavedSettings)) {
-    ImGui::End();
-    return;
-  }
   if (!s.lab && !s.choose(s.scene_environment ? Lab2dState::Source::Scene : s.source)) s.choose(Lab2dState::Source::Constant);
   if (!s.lab) {
     ImGui::TextColored(kRed, "%s", s.error.c_str());

@@ -10,6 +10,24 @@
 
 namespace pdflab::ui::draw {
 
+bool begin_lab_window(const char* title, bool* open, std::array<float, 3>& sized_for, float fonts_wide,
+                      float fonts_high) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float font = ImGui::GetFontSize();
+  const float w = std::max(300.0f, std::min(display.x - 20.0f, font * fonts_wide));
+  const float h = std::max(300.0f, std::min(display.y - 20.0f, font * fonts_high));
+  const bool resized = sized_for[0] != display.x || sized_for[1] != display.y || sized_for[2] != font;
+  sized_for = {display.x, display.y, font};
+  ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
+  ImGui::SetNextWindowSize(ImVec2(w, h), resized ? ImGuiCond_Always : ImGuiCond_Appearing);
+  ImGui::SetNextWindowBgAlpha(0.97f);
+  if (!ImGui::Begin(title, open, ImGuiWindowFlags_NoSavedSettings)) {
+    ImGui::End();
+    return false;
+  }
+  return true;
+}
+
 double Axis::to_unit(double v) const {
   if (log) {
     const double a = std::log10(std::max(lo, 1e-300));

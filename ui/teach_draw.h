@@ -6,10 +6,19 @@
 
 #include <imgui.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
 namespace pdflab::ui::draw {
+
+// Begins a lab's window (the 1D and 2D labs): at the top left, `fonts_wide`
+// by `fonts_high` font sizes within the display, set when it opens and
+// whenever the display or the UI scale changes (`sized_for` remembers the
+// display's size and font size it was last set for). False: collapsed, and
+// the window already ended.
+bool begin_lab_window(const char* title, bool* open, std::array<float, 3>& sized_for, float fonts_wide,
+                      float fonts_high);
 
 // A data range mapped onto 0..1, linearly or by log10 (log axes clamp values
 // at or below zero to the low end instead of producing NaN).
