@@ -142,13 +142,30 @@ void legend(const ProbeState& s) {
     const std::string name = none ? "no direction" : std::string(technique_name(static_cast<Technique>(t)));
     legend_entry(draw::technique_colour(none ? -1 : t), name.c_str(), count, 0.0f);
     if (none || !is_light_technique(t)) continue;
-    // The light technique's samples split by the target they aim at.
-    for (std::size_t k = 0; k < s.target_labels.size(); ++k) {
-      int n = 0;
-      for (std::size_t i = 0; i < s.samples.size() && i < s.sample_target.size(); ++i)
-        n += s.samples[i].technique == t && s.sample_target[i] == static_cast<int>(k);
-      if (n > 0) legend_entry(target_colour(static_cast<int>(k)), ("to " + s.target_labels[k]).c_str(), n,
-                              ImGui::GetTextLineHeight());
+    // The light technique's samples split by the target they aim at: of many
+    // lights, the kShownTargets most aimed at, and the rest in one line.
+    constexpr std::size_t kShownTargets = 8;
+    std::vector<int> counts(s.target_labels.size(), 0);
+    for (std::size_t i = 0; i < s.samples.size() && i < s.sample_target.size(); ++i) {
+      const int k = s.sample_target[i];
+      if (s.samples[i].technique == t && k >= 0 && static_cast<std::size_t>(k) < counts.size())
+        ++counts[static_cast<std::size_t>(k)];
+    }
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < counts.size(); ++k)
+      if (counts[k] > 0) order.push_back(k);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return counts[a] > counts[b]; });
+    const float indent = ImGui::GetTextLineHeight();
+    int rest = 0;
+    for (std::size_t n = 0; n < order.size(); ++n) {
+      const std::size_t k = order[n];
+      if (n < kShownTargets) legend_entry(target_colour(static_cast<int>(k)), ("to " + s.target_labels[k]).c_str(), counts[k], indent);
+      else rest += counts[k];
+    }
+    if (order.size() > kShownTargets) {
+      ImGui::Dummy(ImVec2(indent + ImGui::GetTextLineHeight(), 0.0f));
+      ImGui::SameLine();
+      ImGui::TextColored(kDim, "to %zu other targets  %d", order.size() - kShownTargets, rest);
     }
   }
 }
