@@ -5,25 +5,35 @@
 #   tests/gui/capture_probe_docs.sh [PDFLAB] [SECONDS] [X% Y%]
 # X% and Y% place the click in the image (default 60 58: the alpha 0.025
 # plate, where the third light is reflected).
+# PROBE_SCENE, PROBE_STRATEGY, PROBE_OUT (a path under docs/) take another
+# scene, strategy and picture (PROBE_WAIT: the seconds to wait for the
+# probe after the click, default 2): docs/probe_light_choice.png is
+#   PROBE_WAIT=20 PROBE_SCENE=assets/scenes/many_lights.json PROBE_STRATEGY=nee-mis+lights:tree \
+#   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 8 50 80
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 inside_xvfb "1600x1000x24" "xdotool import" "$0" "$@"
 shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
-pdflab=${1:-$root/build/release/app/pdflab}
+pdflab=${1:-}
+[ -n "$pdflab" ] || pdflab=$root/build/release/app/pdflab
 seconds=${2:-8}
 px=${3:-60} py=${4:-58}
 
-start_viewer "$pdflab" --scene assets/scenes/veach_mis.json --strategy "nee-mis+bsdf" --window 1600x1000
+scene=${PROBE_SCENE:-assets/scenes/veach_mis.json}
+strategy=${PROBE_STRATEGY:-nee-mis+bsdf}
+out=${PROBE_OUT:-docs/probe_bsdf_lobe.png}
+
+start_viewer "$pdflab" --scene "$scene" --strategy "$strategy" --window 1600x1000
 read -r left top w h <<<"$(layout_py "'%d %d %d %d' % (d['image']['x'], d['image']['y'], d['image']['w'], d['image']['h'])")"
 sleep "$seconds"
 send_key p
 sleep 0.5
 xdotool mousemove "$((left + w * px / 100))" "$((top + h * py / 100))" click 1
 xdotool mousemove 2 2
-sleep 2
-import -window "$wid" "$root/docs/probe_bsdf_lobe.png"
-echo "wrote docs/probe_bsdf_lobe.png"
+sleep "${PROBE_WAIT:-2}"  # the probe's figures are made before it shows
+import -window "$wid" "$root/$out"
+echo "wrote $out"
 send_key p
 quit_viewer
