@@ -12,7 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <set>
 #include <string>
+#include <vector>
 
 namespace pdflab {
 namespace {
@@ -113,6 +115,21 @@ TEST(Probe, ListsTheLightChoiceAtThePoint) {
   ASSERT_EQ(uniform.rows.size(), 2u);
   EXPECT_EQ(uniform.rows[1].probability, 0.5f);
   EXPECT_TRUE(probe_light_choice(s, SamplingPlan::make(Strategy::parse("cosine"), s), floor).rows.empty());
+}
+
+// Of many lights, the probe's rows stay apart: bulbs of one material carry
+// their object numbers, a light of its own material keeps its plain label.
+TEST(Probe, LabelsManyLightsOfOneMaterialApart) {
+  Scene s = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/many_lights.json");
+  s.prepare();
+  const SamplingPlan plan = SamplingPlan::make(Strategy::parse("nee-mis+lights:tree"), s);
+  const std::vector<std::string> labels = target_labels(s, plan.emitters);
+  ASSERT_EQ(labels.size(), plan.emitters.size());
+  ASSERT_GT(labels.size(), 400u);
+  EXPECT_EQ(std::set<std::string>(labels.begin(), labels.end()).size(), labels.size());
+  EXPECT_EQ(std::count(labels.begin(), labels.end(), "panel (quad)"), 1);
+  const std::string& bulb = labels.back();
+  EXPECT_NE(bulb.find(" #" + std::to_string(plan.emitters.spheres.back().index) + " (sphere)"), std::string::npos) << bulb;
 }
 
 TEST(Probe, PdfMapShowsTheLightAboveTheFloor) {

@@ -364,9 +364,7 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
     }
     const Scene& sc = *s.scene;
     s.light_choice = probe_light_choice(sc, *s.plan, s.point);
-    for (const auto& q : s.plan->book_targets.quads) s.target_labels.push_back(target_label(sc, q.quad->material, "quad"));
-    for (const auto& sp : s.plan->book_targets.spheres)
-      s.target_labels.push_back(target_label(sc, sp.sphere->material, "sphere"));
+    s.target_labels = target_labels(sc, s.plan->book_targets);
   }
   s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
                             s.point, kMapWidth, kMapHeight);

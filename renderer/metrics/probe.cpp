@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numbers>
 
 namespace pdflab {
@@ -178,6 +179,23 @@ std::string target_label(const Scene& scene, std::uint32_t material, const char*
   return material_name(scene, material, "target") + " (" + kind + ")";
 }
 
+std::vector<std::string> target_labels(const Scene& scene, const TargetSet& set) {
+  std::vector<std::string> labels;
+  std::vector<std::int32_t> ids;
+  for (const TargetSet::QuadEntry& e : set.quads) labels.push_back(target_label(scene, e.quad->material, "quad")), ids.push_back(e.index);
+  for (const TargetSet::SphereEntry& e : set.spheres)
+    labels.push_back(target_label(scene, e.sphere->material, "sphere")), ids.push_back(e.index);
+  // Targets of one material (a string of bulbs) told apart by their object number.
+  std::map<std::string, int> uses;
+  for (const std::string& l : labels) ++uses[l];
+  for (std::size_t k = 0; k < labels.size(); ++k)
+    if (uses[labels[k]] > 1) {
+      const std::size_t open = labels[k].rfind(" (");
+      labels[k].insert(open, " #" + std::to_string(ids[k]));
+    }
+  return labels;
+}
+
 std::string bsdf_lobe_name(const Scene& scene, const ProbePoint& at) {
   if (!at.found) return "no surface";
   const std::string name = material_name(scene, at.material);
@@ -220,15 +238,15 @@ ProbeLightChoice probe_light_choice(const Scene& scene, const SamplingPlan& plan
   if (!set || !at.found || set->empty()) return out;
   // A light tree reads the point's normal too, as the light sample there does.
   const std::vector<float> p = set->probabilities_at(at.point, set->tree ? at.normal : Vec3(0.0f));
+  const std::vector<std::string> labels = target_labels(scene, *set);
   int j = 0;
   for (const TargetSet::QuadEntry& e : set->quads) {
-    out.rows.push_back({target_label(scene, e.quad->material, "quad"), e.probability, p[static_cast<std::size_t>(j)],
+    out.rows.push_back({labels[static_cast<std::size_t>(j)], e.probability, p[static_cast<std::size_t>(j)],
                         set->receives(at.point, j)});
     ++j;
   }
   for (const TargetSet::SphereEntry& e : set->spheres) {
-    out.rows.push_back({target_label(scene, e.sphere->material, "sphere"), e.probability, p[static_cast<std::size_t>(j)],
-                        true});
+    out.rows.push_back({labels[static_cast<std::size_t>(j)], e.probability, p[static_cast<std::size_t>(j)], true});
     ++j;
   }
   return out;

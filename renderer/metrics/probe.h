@@ -68,6 +68,9 @@ std::string delta_lobe_note(const Scene& scene, const ProbePoint& at);
 std::string material_name(const Scene& scene, std::uint32_t m, const char* fallback = "");
 // A light target's label: its material's name and its shape, e.g. "light (quad)".
 std::string target_label(const Scene& scene, std::uint32_t material, const char* kind);
+// Each target's label in the set's order (quads, then spheres); where several
+// share one, each with its scene object number, e.g. "bulb03 #217 (sphere)".
+std::vector<std::string> target_labels(const Scene& scene, const TargetSet& set);
 
 // Map coordinates (0..1) of a direction in pdf_map's layout.
 void direction_to_map(const ProbePoint& at, const Vec3& direction, float& u, float& v);
