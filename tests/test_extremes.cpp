@@ -400,6 +400,31 @@ TEST(Extremes, ThinWallAtLargeCoordinatesDoesNotLeakLight) {
   }
 }
 
+TEST(Extremes, ShadowRayFindsAShadeJustInFrontOfASphereLight) {
+  // A small sphere lamp inside a closed box whose walls stand 1e-4 of its
+  // radius off it, over a floor: every light sample's shadow ray, which leaves
+  // its own sphere untested and searches up to the point drawn on it
+  // (PathTracer::intersect_shadow), must find the box in front. Nothing lit.
+  const std::string text = R"({
+    "camera": {"width": 10, "height": 10, "vfov": 60, "lookfrom": [0, 3, 3], "lookat": [0, 0, 0], "background": [0, 0, 0]},
+    "materials": {"white": {"type": "lambertian", "albedo": [0.8, 0.8, 0.8]},
+                  "lamp": {"type": "diffuse_light", "emit": [400, 400, 400]}},
+    "objects": [
+      {"type": "quad", "q": [-5, 0, -5], "u": [10, 0, 0], "v": [0, 0, 10], "material": "white"},
+      {"type": "box", "min": [-0.050005, 0.949995, -0.050005], "max": [0.050005, 1.050005, 0.050005], "material": "white"},
+      {"type": "sphere", "center": [0, 1, 0], "radius": 0.05, "material": "lamp"}
+    ]})";
+  auto scene = std::make_shared<Scene>(load_scene_text(text, "shade.json"));
+  for (const char* strategy : {"nee-mis", "nee-mis+lights:tree", "mix:cosine=0.5,light-sa=0.5"}) {
+    const Rendered r = render(scene, strategy, 16);
+    for (std::size_t p = 0; p < r.film.pixel_count(); ++p) {
+      double m[3];
+      r.film.mean(p, m);
+      ASSERT_EQ(m[0] + m[1] + m[2], 0.0) << strategy << ": light passed the shade into pixel " << p;
+    }
+  }
+}
+
 TEST(Extremes, SpheresLargeAgainstTheSceneAreTestedInFloat) {
   const Scene book = load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/cornell_book.json");
   ASSERT_EQ(book.spheres.size(), 1u);
