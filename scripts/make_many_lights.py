@@ -96,10 +96,12 @@ def main():
         "name": "A room lit by many lights",
         "description": f"A room lit by {bulbs} bulbs on {args.strings} strings and four lamps "
                        "(scripts/make_many_lights.py). Choosing the emitter by power sends most light samples "
-                       "to bulbs far from the point; the light tree (light_choice tree) chooses by power, "
+                       "to bulbs far from the point; the light tree, this scene's light choice, chooses by power, "
                        "distance and orientation.",
         "camera": {"width": 160, "height": 120, "vfov": 62, "lookfrom": [5.0, 1.7, 0.4], "lookat": [5.0, 1.9, 8.0],
                    "vup": [0, 1, 0], "max_depth": 5},
+        # Hundreds of small lights: the scene asks for the light tree (a strategy's +lights:power overrides it).
+        "light_choice": "tree",
         "materials": materials,
         "objects": objects,
     }

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The light tree against the choice by power on assets/scenes/many_lights.json
 # (docs/many_lights.md, "The light tree"), from the CLI alone:
-#   1. a reference (pdflab reference, REF_SPP samples per pixel of plain
-#      nee-mis, the choice by power: the established estimator, so that a
+#   1. a reference (pdflab reference, REF_SPP samples per pixel of
+#      nee-mis+lights:power, the choice by power: the established estimator, so that a
 #      fault of the tree cannot hide in the reference; at least 32x every run
 #      below);
 #   2. each strategy timed at SPP samples per pixel on one thread (its CPU
@@ -23,12 +23,12 @@ seeds=${SEEDS:-"101 102 103 104 105 106 107 108"}
 ref_spp=${REF_SPP:-512}
 width=${WIDTH:-80}
 height=${HEIGHT:-60}
-read -r -a strategies <<< "${STRATEGIES:-nee-mis nee-mis+lights:tree}"
+read -r -a strategies <<< "${STRATEGIES:-nee-mis+lights:power nee-mis+lights:tree}"
 scene=$here/assets/scenes/many_lights.json
 size=(--width "$width" --height "$height")
 mkdir -p "$out"
 
-[ -f "$out/ref.pfm" ] || "$pdflab" reference --scene "$scene" "${size[@]}" --strategy nee-mis \
+[ -f "$out/ref.pfm" ] || "$pdflab" reference --scene "$scene" "${size[@]}" --strategy nee-mis+lights:power \
   --spp "$ref_spp" --out "$out/ref.pfm" --cache-dir "$out/cache" --quiet
 
 declare -a seconds

@@ -328,7 +328,7 @@ TEST(Convergence, LightTreeAgreesWithPowerChoice) {
   for (const auto& scene : {room, sky, frosted}) {
     SCOPED_TRACE(scene->name);
     ASSERT_NE(SamplingPlan::make(Strategy::parse("nee-mis+lights:tree"), *scene).emitters.tree, nullptr);
-    const BlockImage reference = render_blocks("nee-mis", seed++, 512, scene);
+    const BlockImage reference = render_blocks("nee-mis+lights:power", seed++, 512, scene);
     const Comparison cmp = compare(render_blocks("nee-mis+lights:tree", seed++, 256, scene), reference);
     std::printf("[convergence] %-28s nee-mis+lights:tree block z in [%+.2f, %+.2f] (limit %.2f)\n", scene->name.c_str(),
                 cmp.most_negative, cmp.most_positive, limit);
