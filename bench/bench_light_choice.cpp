@@ -90,12 +90,15 @@ int main(int argc, char** argv) {
     for (Draw& d : draws) d = {Vec3(10.0f * rng.uniform(), 0.0f, 12.0f * rng.uniform()), rng.next_u32(), rng.uniform(), rng.uniform()};
     const Vec3 up(0.0f, 1.0f, 0.0f);
     volatile float sink = 0.0f;
-    const auto light_sample = [&](const SamplingPlan& plan, bool reached_only) {
+    const auto light_sample = [&](const SamplingPlan& plan, bool by_tree) {
       return best_ns_per_call(calls, [&](int i) {
         const Draw& d = draws[static_cast<std::size_t>(i)];
         leaf::SolidAngleSetup setup{-1, {}};
-        const leaf::Sampled s = leaf::sample_solid_angle_targets(plan.emitters, d.point, static_cast<std::int32_t>(d.u), d.u1,
-                                                                 d.u2, true, setup, &up, reached_only);
+        const leaf::Sampled s =
+            by_tree ? leaf::sample_tree_targets(plan.emitters, d.point, &up, static_cast<std::int32_t>(d.u), d.u1, d.u2, true,
+                                                setup, true, nullptr, nullptr)
+                    : leaf::sample_solid_angle_targets(plan.emitters, d.point, static_cast<std::int32_t>(d.u), d.u1, d.u2,
+                                                       true, setup);
         sink = sink + s.pdf;
       });
     };

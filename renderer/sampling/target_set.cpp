@@ -94,6 +94,7 @@ float TargetSet::pdf_without(const Vec3& origin, const Vec3& direction, const vo
 }
 
 float TargetSet::pdf(const Vec3& origin, const Vec3& direction, int aimed_quad, float aimed_t) const {
+  if (tree) return leaf::tree_targets_pdf(*this, origin, direction, aimed_quad, aimed_t, true, nullptr, -1);
   if (solid_angle) return leaf::solid_angle_targets_pdf(*this, origin, direction, aimed_quad, aimed_t, true, nullptr);
   return pdf_without(origin, direction, nullptr, aimed_quad, aimed_t);
 }
@@ -101,8 +102,10 @@ float TargetSet::pdf(const Vec3& origin, const Vec3& direction, int aimed_quad, 
 DirectionSample TargetSet::sample(const Vec3& origin, std::uint32_t u_choice, float u1, float u2) const {
   if (solid_angle) {
     leaf::SolidAngleSetup setup{-1, {}};
-    return to_direction_sample(
-        leaf::sample_solid_angle_targets(*this, origin, static_cast<std::int32_t>(u_choice), u1, u2, true, setup));
+    const std::int32_t u = static_cast<std::int32_t>(u_choice);
+    return to_direction_sample(tree ? leaf::sample_tree_targets(*this, origin, nullptr, u, u1, u2, true, setup, false,
+                                                                nullptr, nullptr)
+                                    : leaf::sample_solid_angle_targets(*this, origin, u, u1, u2, true, setup));
   }
   if (empty()) return {Vec3(0.0f, 0.0f, 1.0f), 0.0f, true};  // nothing to aim at
   const int chosen = choice.sample(u_choice);
