@@ -4,9 +4,12 @@
 // (renderer/integrator/kernel.inc); the one-path tracer, the probe and
 // the tests call these.
 #include "renderer/math.h"
+#include "renderer/sampling/light_tree.h"
 #include "renderer/scene/scene.h"
 
+#include <bit>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 namespace pdflab {
@@ -67,6 +70,12 @@ using Double = double;
 PDFLAB_LEAF Double to_double(Float x) { return x; }
 PDFLAB_LEAF Float to_float(Double x) { return static_cast<float>(x); }
 PDFLAB_LEAF Double lane_sqrt(Double x) { return std::sqrt(x); }
+PDFLAB_LEAF Int lane_trunc(Double x) { return static_cast<Int>(x); }
+PDFLAB_LEAF Int lane_int_bits(Float x) { return std::bit_cast<Int>(x); }
+// The 16 floats of row `index` of a table of 64-byte rows.
+PDFLAB_LEAF void lane_rows16(const float* rows, Int index, Float (&field)[16]) {
+  std::memcpy(field, rows + 16 * static_cast<std::ptrdiff_t>(index), sizeof field);
+}
 // One path is one lane: lane 0, there when the mask is.
 template <class F>
 PDFLAB_LEAF void each_lane(Mask m, F f) {

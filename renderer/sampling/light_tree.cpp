@@ -1,5 +1,7 @@
 #include "renderer/sampling/light_tree.h"
 
+#include "renderer/sampling/leaf.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -8,8 +10,6 @@
 namespace pdflab {
 
 namespace {
-
-constexpr std::uint32_t kChoiceRange = 1u << 24;  // the top 24 bits of the 32-bit number choose
 
 // A cone of directions: its axis and the cosine of its half-angle (-1: every direction).
 struct Cone {
@@ -40,14 +40,6 @@ Cone merge(const Cone& a, const Cone& b) {
   return {axis, static_cast<float>(std::cos(std::min(half + 1e-5, std::numbers::pi)))};
 }
 
-// cos(max(0, angle - bound)) from the cosines of angle and bound (both in [0, pi]).
-float cos_less(float cos_angle, float cos_bound) {
-  if (cos_angle >= cos_bound) return 1.0f;
-  const float sin_angle = std::sqrt(std::max(0.0f, 1.0f - cos_angle * cos_angle));
-  const float sin_bound = std::sqrt(std::max(0.0f, 1.0f - cos_bound * cos_bound));
-  return cos_angle * cos_bound + sin_angle * sin_bound;
-}
-
 }  // namespace
 
 LightTree::LightTree(const std::vector<Emitter>& emitters, float floor_share) : count_(static_cast<int>(emitters.size())) {
@@ -61,7 +53,18 @@ LightTree::LightTree(const std::vector<Emitter>& emitters, float floor_share) : 
   std::iota(order.begin(), order.end(), 0);
   nodes_.reserve(2 * emitters.size());
   nodes_.emplace_back();
+  bounds_.emplace_back();
   build(0, order, 0, count_, emitters, 0, 0);
+  bounds_ = {};
+}
+
+void LightTree::set_box(int at, const Vec3& lo, const Vec3& hi) {
+  bounds_[static_cast<std::size_t>(at)] = {lo, hi};
+  Node& n = nodes_[static_cast<std::size_t>(at)];
+  n.centre = (lo + hi) * 0.5f;
+  const Vec3 half = (hi - lo) * 0.5f;
+  n.radius2 = glm::dot(half, half);
+  n.radius = std::sqrt(n.radius2);
 }
 
 // Node `at` over order[begin, end): a leaf for one emitter, else split along
@@ -71,8 +74,10 @@ void LightTree::build(int at, std::vector<int>& order, int begin, int end, const
   if (end - begin == 1) {
     const Emitter& e = emitters[static_cast<std::size_t>(order[static_cast<std::size_t>(begin)])];
     Node& n = nodes_[static_cast<std::size_t>(at)];
-    n.lo = e.lo, n.hi = e.hi, n.axis = e.axis, n.power = e.power;
+    n.axis = e.axis, n.power = e.power;
     n.cos_spread = e.two_sided ? -1.0f : e.cos_spread;
+    n.sin_spread = n.cos_spread <= -1.0f ? 0.0f : std::sqrt(std::max(0.0f, 1.0f - n.cos_spread * n.cos_spread));
+    set_box(at, e.lo, e.hi);
     n.light = order[static_cast<std::size_t>(begin)];
     path_[static_cast<std::size_t>(n.light)] = path;
     path_length_[static_cast<std::size_t>(n.light)] = static_cast<std::uint8_t>(length);
@@ -106,109 +111,35 @@ void LightTree::build(int at, std::vector<int>& order, int begin, int end, const
   const int child = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
   nodes_.emplace_back();
+  bounds_.emplace_back();
+  bounds_.emplace_back();
   build(child, order, begin, middle, emitters, path, length + 1);
   build(child + 1, order, middle, end, emitters, path | (std::uint64_t{1} << length), length + 1);
   const Node& l = nodes_[static_cast<std::size_t>(child)];
   const Node& r = nodes_[static_cast<std::size_t>(child + 1)];
   const Cone cone = merge({l.axis, l.cos_spread}, {r.axis, r.cos_spread});
+  const Box& lb = bounds_[static_cast<std::size_t>(child)];
+  const Box& rb = bounds_[static_cast<std::size_t>(child + 1)];
+  set_box(at, glm::min(lb.lo, rb.lo), glm::max(lb.hi, rb.hi));
   Node& n = nodes_[static_cast<std::size_t>(at)];
-  n.lo = glm::min(l.lo, r.lo);
-  n.hi = glm::max(l.hi, r.hi);
   n.axis = cone.axis;
   n.cos_spread = cone.cos_spread;
+  n.sin_spread = n.cos_spread <= -1.0f ? 0.0f : std::sqrt(std::max(0.0f, 1.0f - n.cos_spread * n.cos_spread));
   n.power = l.power + r.power;
   n.child = child;
 }
 
-// power * (bound on the emitted cosine) * (bound on the received cosine) / distance^2,
-// the bounds over the node's bounding sphere as seen from the point.
-float LightTree::importance(const Node& node, const Vec3& point, const Vec3& normal) const {
-  if (!(node.power > 0.0f)) return 0.0f;
-  const Vec3 centre = (node.lo + node.hi) * 0.5f;
-  const Vec3 half = (node.hi - node.lo) * 0.5f;
-  const float r2 = glm::dot(half, half);
-  const Vec3 d = point - centre;
-  const float dist2 = glm::dot(d, d);
-  const float clamped = std::max(dist2, 0.25f * r2);
-  if (dist2 <= r2 || !(dist2 > 0.0f)) return node.power / std::max(clamped, 1e-30f);  // inside its bounding sphere
-  const float dist = std::sqrt(dist2);
-  const Vec3 w = d / dist;  // from the node to the point
-  const float sin_u = std::sqrt(r2) / dist;
-  const float cos_u = std::sqrt(std::max(0.0f, 1.0f - sin_u * sin_u));
-  float emitted = 1.0f;
-  if (node.cos_spread > -1.0f) {
-    // The angle from the axis to the point, less the cone's spread, less what the sphere subtends.
-    const float c = glm::dot(node.axis, w);
-    float beyond = cos_less(c, node.cos_spread);
-    if (beyond < 1.0f) {
-      // beyond - theta_u: cos(a - u) where a is the angle whose cosine is beyond.
-      beyond = cos_less(beyond, cos_u);
-    }
-    if (!(beyond > 0.0f)) return 0.0f;
-    emitted = beyond;
-  }
-  float received = 1.0f;
-  if (normal.x != 0.0f || normal.y != 0.0f || normal.z != 0.0f) {
-    received = cos_less(-glm::dot(normal, w), cos_u);
-    if (!(received > 0.0f)) return 0.0f;
-  }
-  return node.power * emitted * received / clamped;
-}
-
-std::uint32_t LightTree::left_count(const Node& node, const Vec3& point, const Vec3& normal, std::uint32_t range) const {
-  const Node& l = nodes_[static_cast<std::size_t>(node.child)];
-  const Node& r = nodes_[static_cast<std::size_t>(node.child + 1)];
-  double a = importance(l, point, normal), b = importance(r, point, normal);
-  if (!(a + b > 0.0) || !std::isfinite(a + b)) {
-    // Nothing to tell them apart (the point sees neither): by power, or evenly.
-    a = l.power, b = r.power;
-    if (!(a + b > 0.0) || !std::isfinite(a + b)) a = b = 1.0;
-  }
-  const double count = std::floor(a / (a + b) * range + 0.5);
-  return static_cast<std::uint32_t>(std::clamp(count, 0.0, static_cast<double>(range)));
-}
-
+// The choice and the probability are leaf::tree_choose and tree_probability,
+// the packet tracer's own functions in one lane.
 LightTree::Choice LightTree::sample(const Vec3& point, const Vec3& normal, std::uint32_t u) const {
-  if (count_ <= 1) return {0, 1.0f};
-  std::uint32_t v = u >> 8;
-  const std::uint32_t floor_total = floor_count_ * static_cast<std::uint32_t>(count_);
-  if (v < floor_total) {
-    const int light = static_cast<int>(v / floor_count_);
-    return {light, probability(point, normal, light)};
-  }
-  v -= floor_total;
-  std::uint32_t range = kChoiceRange - floor_total;
-  const Node* node = &nodes_[0];
-  while (node->child >= 0) {
-    const std::uint32_t left = left_count(*node, point, normal, range);
-    if (v < left) {
-      range = left;
-      node = &nodes_[static_cast<std::size_t>(node->child)];
-    } else {
-      v -= left;
-      range -= left;
-      node = &nodes_[static_cast<std::size_t>(node->child + 1)];
-    }
-  }
-  return {node->light, static_cast<float>(floor_count_ + range) * 0x1.0p-24f};
+  Choice c{0, 1.0f};
+  leaf::tree_choose(*this, point, normal, leaf::has_direction(normal), static_cast<std::int32_t>(u), true, c.light,
+                    c.probability);
+  return c;
 }
 
 float LightTree::probability(const Vec3& point, const Vec3& normal, int light) const {
-  if (count_ <= 1) return 1.0f;
-  std::uint32_t range = kChoiceRange - floor_count_ * static_cast<std::uint32_t>(count_);
-  const std::uint64_t path = path_[static_cast<std::size_t>(light)];
-  const Node* node = &nodes_[0];
-  for (int k = 0; node->child >= 0; ++k) {
-    const std::uint32_t left = left_count(*node, point, normal, range);
-    if ((path >> k) & 1u) {
-      range -= left;
-      node = &nodes_[static_cast<std::size_t>(node->child + 1)];
-    } else {
-      range = left;
-      node = &nodes_[static_cast<std::size_t>(node->child)];
-    }
-  }
-  return static_cast<float>(floor_count_ + range) * 0x1.0p-24f;
+  return leaf::tree_probability(*this, point, normal, leaf::has_direction(normal), light, true);
 }
 
 std::vector<float> LightTree::probabilities(const Vec3& point, const Vec3& normal) const {

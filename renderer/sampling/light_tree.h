@@ -23,7 +23,9 @@
 // 2^-24 and so exact in float, and the same count is found again by following
 // its path from the root (its bits), with the same float operations: sampler
 // and pmf agree to the last bit, and the pmf of one emitter costs a descent,
-// not a sum over every emitter.
+// not a sum over every emitter. The descent is leaf::tree_descent
+// (leaf_math.inc), which the packet tracer runs for all its lanes at once;
+// sample and probability here are the same function in one lane.
 #include "renderer/math.h"
 
 #include <cstdint>
@@ -69,22 +71,41 @@ class LightTree {
   // The tree's depth (the longest path from the root to an emitter).
   int depth() const;
 
- private:
-  struct Node {
-    Vec3 lo, hi;
+  // A node as the descent reads it (leaf::tree_descent): one 64-byte row of
+  // 16 floats, so that the packet tracer reads the rows of all its lanes at
+  // once. The sphere around the node's box, its cone and power; the box
+  // itself is the build's alone (bounds_).
+  struct alignas(64) Node {
+    Vec3 centre;       // of the box
+    float radius2;     // the squared half-diagonal of the box: the sphere through its corners
     Vec3 axis;
     float cos_spread;  // of the emitters' normals about axis (-1: every direction); each emits up to 90 degrees beyond
+    float sin_spread;  // of the same angle (0 where cos_spread is -1)
+    float radius;      // sqrt(radius2)
     float power;
     std::int32_t child = -1;  // the left child (the right one is child + 1); -1: a leaf
     std::int32_t light = -1;  // a leaf's emitter
+    float unused[3] = {};
   };
-  float importance(const Node& node, const Vec3& point, const Vec3& normal) const;
-  // The left child's share of a node's `range` numbers from `point`.
-  std::uint32_t left_count(const Node& node, const Vec3& point, const Vec3& normal, std::uint32_t range) const;
+  static constexpr std::uint32_t kChoiceRange = 1u << 24;  // the top 24 bits of the 32-bit number choose
+
+  const Node* nodes() const { return nodes_.data(); }
+  // Emitter `light`'s path from the root: bit k the side taken at depth k (1: right).
+  std::uint64_t path(int light) const { return path_[static_cast<std::size_t>(light)]; }
+  // The numbers of the 2^24 each emitter has in the uniform floor.
+  std::uint32_t floor_count() const { return floor_count_; }
+
+ private:
+  struct Box {
+    Vec3 lo, hi;
+  };
   void build(int at, std::vector<int>& order, int begin, int end, const std::vector<Emitter>& emitters,
              std::uint64_t path, int length);
 
+  void set_box(int at, const Vec3& lo, const Vec3& hi);
+
   std::vector<Node> nodes_;  // the root first
+  std::vector<Box> bounds_;  // per node, for the build
   std::vector<std::uint64_t> path_;  // per emitter: bit k is the side taken at depth k (1: right)
   std::vector<std::uint8_t> path_length_;
   int count_ = 0;
