@@ -7,9 +7,12 @@
 # plate, where the third light is reflected).
 # PROBE_SCENE, PROBE_STRATEGY, PROBE_OUT (a path under docs/) take another
 # scene, strategy and picture (PROBE_WAIT: the seconds to wait for the
-# probe after the click, default 2): docs/probe_light_choice.png is
+# probe after the click, default 2). docs/probe_many_lights.png (docs/many_lights.md) is
 #   PROBE_WAIT=20 PROBE_SCENE=assets/scenes/many_lights.json PROBE_STRATEGY=nee-mis+lights:tree \
-#   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 8 50 80
+#   PROBE_OUT=docs/probe_many_lights.png tests/gui/capture_probe_docs.sh "" 8 50 80
+# and docs/probe_light_choice.png (the README's starved box) is
+#   PROBE_WAIT=8 PROBE_SCENE=assets/scenes/starved_light.json PROBE_STRATEGY=nee-mis \
+#   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 10 30 88
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 inside_xvfb "1600x1000x24" "xdotool import" "$0" "$@"
