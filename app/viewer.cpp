@@ -1049,6 +1049,7 @@ void Viewer::Impl::fill_status() {
   status.threads = session->thread_count();
   status.scene_name = base_scene->name;
   status.scene_path = scene_path;
+  status.scene_light_choice = base_scene->light_choice;
   status.base_width = base_scene->camera.width;
   status.base_height = base_scene->camera.height;
   status.width = render_scene ? render_scene->camera.width : 0;

@@ -600,7 +600,19 @@ void draw_measure_section(ViewerSettings& settings, const UiStatus& status, UiRe
   if (ImGui::Button("Clear pins")) requests.measure.clear_pins = true;
 }
 
-void draw_nee_explanation(const SamplingSettings& s) {
+namespace {
+// How the note says nee-mis chooses its light sample's emitter.
+const char* light_choice_words(LightChoice choice) {
+  switch (choice) {
+    case LightChoice::Uniform: return "an emitter chosen uniformly";
+    case LightChoice::Tree: return "an emitter chosen by the light tree, from power, distance and orientation";
+    case LightChoice::Power: break;
+  }
+  return "an emitter chosen by power";
+}
+}  // namespace
+
+void draw_nee_explanation(const SamplingSettings& s, LightChoice choice) {
   // Closed at first: the note is long, the panel is for controls.
   const bool open = ImGui::TreeNodeEx("why? (how nee-mis differs from a mixture)", ImGuiTreeNodeFlags_None);
   layout::item("sampling.nee_why");
@@ -624,10 +636,11 @@ void draw_nee_explanation(const SamplingSettings& s) {
   ImGui::Spacing();
   if (cosine_alone) {
     ImGui::TextWrapped(
-        "nee-mis takes TWO samples at every diffuse vertex: a light sample (an emitter chosen by power, sampled by "
-        "solid angle) tested with a shadow ray, and a cosine sample that continues the path. Each is weighted "
-        "against the OTHER technique's pdf for the same direction: power heuristic p_a^2 / (p_a^2 + p_b^2), or "
-        "balance p_a / (p_a + p_b). Every path to a light is counted once in total.");
+        "nee-mis takes TWO samples at every diffuse vertex: a light sample (%s, sampled by solid angle) tested "
+        "with a shadow ray, and a cosine sample that continues the path. Each is weighted against the OTHER "
+        "technique's pdf for the same direction: power heuristic p_a^2 / (p_a^2 + p_b^2), or balance "
+        "p_a / (p_a + p_b). Every path to a light is counted once in total.",
+        light_choice_words(choice));
     ImGui::Spacing();
     ImGui::TextWrapped(
         "Unbiased: the cosine sample reaches every direction. Per sample, noise from small lights falls much "
@@ -636,11 +649,11 @@ void draw_nee_explanation(const SamplingSettings& s) {
         "Convergence plot). It aims at emitters only, not at the glass sphere.");
   } else {
     ImGui::TextWrapped(
-        "This strategy takes TWO samples at every diffuse vertex: a light sample (an emitter chosen by power) "
-        "tested with a shadow ray, and a sample of the mixture %s that continues the path. The light sample is "
-        "weighted against the MIXTURE's density for its direction and emission the continuation reaches against "
-        "the light technique's, by the %s heuristic, so every path to a light is counted once in total.",
-        continuation.c_str(), strategy.heuristic == MisHeuristic::Power ? "power" : "balance");
+        "This strategy takes TWO samples at every diffuse vertex: a light sample (%s) tested with a shadow ray, "
+        "and a sample of the mixture %s that continues the path. The light sample is weighted against the "
+        "MIXTURE's density for its direction and emission the continuation reaches against the light "
+        "technique's, by the %s heuristic, so every path to a light is counted once in total.",
+        light_choice_words(choice), continuation.c_str(), strategy.heuristic == MisHeuristic::Power ? "power" : "balance");
     ImGui::Spacing();
     ImGui::TextWrapped(
         "Unbiased while the mixture has a technique that reaches every direction (cosine). Its other techniques aim "

@@ -22,7 +22,8 @@ void draw_view_mode_selector(ViewerSettings& settings);
 void draw_layer_controls(ViewerSettings& settings, const MeasureState* measure);
 // "How is this different?": nee-mis (with the continuation `s` has: cosine
 // alone, or fastest's mixture) against the book's one-sample mixture.
-void draw_nee_explanation(const SamplingSettings& s);
+// `choice`: how the light sample's emitter is chosen (the strategy's, else the scene's).
+void draw_nee_explanation(const SamplingSettings& s, LightChoice choice);
 // The false-colour layer (texture: ViewTexture::id, 0 for none) over the
 // image, its legend and the convergence plot, placed by ui/layout_report.
 void draw_image_overlays(const ImageRect& image, ViewerSettings& settings, const MeasureState& measure,

@@ -428,7 +428,7 @@ void sampling_section(ViewerSettings& settings, PanelState& state, const UiStatu
   strategy_combo(s);
   layout::item("sampling.strategy");
   technique_parameters(s);
-  if (s.nee_mis) draw_nee_explanation(s);
+  if (s.nee_mis) draw_nee_explanation(s, s.light_choice.value_or(status.scene_light_choice));
   if (s.mixture && !s.nee_mis) {
     pair_weight_slider(settings, state, status, requests);
     mixture_weights(s);

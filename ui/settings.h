@@ -162,6 +162,7 @@ struct UiStatus {
   int threads = 0;
   std::string scene_name;
   std::string scene_path;
+  LightChoice scene_light_choice = LightChoice::Power;  // the scene file's `light_choice`
   int base_width = 0, base_height = 0;  // the scene's own resolution
   int width = 0, height = 0;            // rendered resolution
   std::vector<std::string> scene_files;  // assets/scenes/*.json
