@@ -67,6 +67,12 @@ void LightTree::set_box(int at, const Vec3& lo, const Vec3& hi) {
   n.radius = std::sqrt(n.radius2);
 }
 
+void LightTree::set_cone(Node& n, const Vec3& axis, float cos_spread) {
+  n.axis = axis;
+  n.cos_spread = cos_spread;
+  n.sin_spread = cos_spread <= -1.0f ? 0.0f : std::sqrt(std::max(0.0f, 1.0f - cos_spread * cos_spread));
+}
+
 // Node `at` over order[begin, end): a leaf for one emitter, else split along
 // the axis where the emitters' centres spread most.
 void LightTree::build(int at, std::vector<int>& order, int begin, int end, const std::vector<Emitter>& emitters,
@@ -74,9 +80,8 @@ void LightTree::build(int at, std::vector<int>& order, int begin, int end, const
   if (end - begin == 1) {
     const Emitter& e = emitters[static_cast<std::size_t>(order[static_cast<std::size_t>(begin)])];
     Node& n = nodes_[static_cast<std::size_t>(at)];
-    n.axis = e.axis, n.power = e.power;
-    n.cos_spread = e.two_sided ? -1.0f : e.cos_spread;
-    n.sin_spread = n.cos_spread <= -1.0f ? 0.0f : std::sqrt(std::max(0.0f, 1.0f - n.cos_spread * n.cos_spread));
+    n.power = e.power;
+    set_cone(n, e.axis, e.two_sided ? -1.0f : e.cos_spread);
     set_box(at, e.lo, e.hi);
     n.light = order[static_cast<std::size_t>(begin)];
     path_[static_cast<std::size_t>(n.light)] = path;
@@ -122,9 +127,7 @@ void LightTree::build(int at, std::vector<int>& order, int begin, int end, const
   const Box& rb = bounds_[static_cast<std::size_t>(child + 1)];
   set_box(at, glm::min(lb.lo, rb.lo), glm::max(lb.hi, rb.hi));
   Node& n = nodes_[static_cast<std::size_t>(at)];
-  n.axis = cone.axis;
-  n.cos_spread = cone.cos_spread;
-  n.sin_spread = n.cos_spread <= -1.0f ? 0.0f : std::sqrt(std::max(0.0f, 1.0f - n.cos_spread * n.cos_spread));
+  set_cone(n, cone.axis, cone.cos_spread);
   n.power = l.power + r.power;
   n.child = child;
 }
@@ -139,7 +142,8 @@ LightTree::Choice LightTree::sample(const Vec3& point, const Vec3& normal, std::
 }
 
 float LightTree::probability(const Vec3& point, const Vec3& normal, int light) const {
-  return leaf::tree_probability(*this, point, normal, leaf::has_direction(normal), light, true);
+  return leaf::tree_probability(*this, point, normal, leaf::has_direction(normal), static_cast<std::int32_t>(light),
+                                true);
 }
 
 std::vector<float> LightTree::probabilities(const Vec3& point, const Vec3& normal) const {

@@ -94,6 +94,8 @@ class LightTree {
   std::uint64_t path(int light) const { return path_[static_cast<std::size_t>(light)]; }
   // The numbers of the 2^24 each emitter has in the uniform floor.
   std::uint32_t floor_count() const { return floor_count_; }
+  // The numbers of the floor in all: below it, a number chooses an emitter evenly.
+  std::uint32_t floor_total() const { return floor_count_ * static_cast<std::uint32_t>(count_); }
 
  private:
   struct Box {
@@ -103,6 +105,8 @@ class LightTree {
              std::uint64_t path, int length);
 
   void set_box(int at, const Vec3& lo, const Vec3& hi);
+  // The node's cone, and the sine of its spread beside the cosine.
+  static void set_cone(Node& n, const Vec3& axis, float cos_spread);
 
   std::vector<Node> nodes_;  // the root first
   std::vector<Box> bounds_;  // per node, for the build
