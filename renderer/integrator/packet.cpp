@@ -114,6 +114,11 @@ void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, co
   PDFLAB_PACKET_CALL(isa, plan_pdf_impl(plan, draws, directions, n, out));
 }
 
+void sample_emitters(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n,
+                     DirectionSample* out) {
+  PDFLAB_PACKET_CALL(isa, sample_emitters_impl(plan, draws, n, out));
+}
+
 void nearest_hits(PacketIsa isa, const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out) {
   PDFLAB_PACKET_CALL(isa, nearest_hits_impl(scene, rays, n, out));
 }

@@ -87,6 +87,13 @@ void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws,
 void plan_pdf(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,
               float* out);
 
+// nee-mis's light sample from the plan's emitter set (SamplingPlan::emitters,
+// drawn by solid angle: TargetSet::solid_angle), `packet_lanes` at a time
+// through the code the packet tracer renders with, as TargetSet::sample draws
+// it (each draw's point, u_choice, u1 and u2; no normal).
+void sample_emitters(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n,
+                     DirectionSample* out);
+
 // A ray as a path follows it, for nearest_hits: aimed at object `aimed` (a
 // quad's number, or a sphere's: quads, then spheres; -1: none) at distance
 // `aimed_t` (leaf::Sampled::aimed_quad and aimed_distance).

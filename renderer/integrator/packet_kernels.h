@@ -77,6 +77,8 @@ namespace pdflab {
   void sample_plan_impl(const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out); \
   void plan_pdf_impl(const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,  \
                      float* out);                                                                            \
+  void sample_emitters_impl(const SamplingPlan& plan, const PlanDraw* draws, std::size_t n,                  \
+                            DirectionSample* out);                                                           \
   void nearest_hits_impl(const Scene& scene, const TracedRay* rays, std::size_t n, NearestHit* out);
 
 namespace packet_generic {
