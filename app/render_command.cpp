@@ -499,6 +499,10 @@ void write_render_stats(const RenderOptions& o, const RenderPlan& plan, const Re
   j["samples"] = st.samples;
   j["samples_per_second"] = st.samples_per_second;
   j["dropped"] = drops_json(r.info.dropped);
+  if (st.guiding_passes > 0)
+    j["guiding"] = {{"training_passes", st.guiding_passes}, {"records", st.guiding_records},
+                    {"leaves", st.guiding.leaves}, {"nodes", st.guiding.nodes},
+                    {"max_depth", st.guiding.max_depth}, {"bytes", st.guiding.bytes}};
   j["output"] = o.out;
   if (!plan.film_out.empty()) j["film"] = plan.film_out;
   // The film's own estimate is a lower bound: it cannot see what the samples never found.
@@ -530,6 +534,12 @@ void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const 
   std::printf("%llu spp, %dx%d, %.2f s, %.3f M samples/s, %d threads, %s -> %s\n",
               static_cast<unsigned long long>(r.info.spp()), r.info.width, r.info.height, st.seconds,
               st.samples_per_second * 1e-6, r.threads, drops_text(r.info.dropped).c_str(), printable(target).c_str());
+  if (st.guiding_passes > 0)
+    std::printf("path guiding: %d training passes of 1 to %u spp (discarded; their time is in the %.2f s), %llu "
+                "records; the SD-tree: %d leaves, %zu quadtree nodes, %d levels deep, %.2f MiB\n",
+                st.guiding_passes, 1u << (st.guiding_passes - 1), st.seconds,
+                static_cast<unsigned long long>(st.guiding_records), st.guiding.leaves, st.guiding.nodes,
+                st.guiding.max_depth, static_cast<double>(st.guiding.bytes) / (1024.0 * 1024.0));
   if (reference.loaded()) {
     std::printf("relMSE %.4g +- %.2g (95%%) against %s; raw %.4g, of which the reference's own noise is %.1f%%%s; "
                 "efficiency %.4g\n",

@@ -305,9 +305,13 @@ std::vector<Param> cases() {
                                                      "nee-mis:balance+mix:cosine=0.5,light-sa=0.5+rr:1",
                                                      // the +sobol sampler
                                                      "mix:cosine=0.5,light=0.5+sobol", "nee-mis+sobol"};
-  // Half of uniform-sphere's samples go below the floor.
+  // Half of uniform-sphere's samples go below the floor (and untrained
+  // guiding's, guided:0, the uniform sphere).
   const auto blind_spp = [](const std::string& s) {
-    return s == "cosine" ? 4096u : s.find("light") != std::string::npos ? 256u : s == "uniform-sphere" ? 16384u : 8192u;
+    return s == "cosine"                                ? 4096u
+           : s.find("light") != std::string::npos       ? 256u
+           : s == "uniform-sphere" || s == "guided:0"   ? 16384u
+                                                        : 8192u;
   };
   std::vector<std::string> blind_strategies = {"cosine", "uniform-hemisphere", "mix:uniform-sphere=0.5,light=0.5"};
   // Every technique of the table, alone and mixed with cosine: those that aim

@@ -101,8 +101,8 @@ int packet_lanes(PacketIsa isa) {
 #endif
 
 void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
-                 const SampleBlock& block, SampleResult* out) {
-  PDFLAB_PACKET_CALL(isa, trace_block_impl(scene, plan, seed, block, out));
+                 const SampleBlock& block, SampleResult* out, GuidingTrainer* trainer) {
+  PDFLAB_PACKET_CALL(isa, trace_block_impl(scene, plan, seed, block, out, trainer));
 }
 
 void sample_plan(PacketIsa isa, const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out) {
@@ -130,8 +130,8 @@ void nearest_hits(const Scene& scene, const TracedRay* rays, std::size_t n, Near
 }
 
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
-                 SampleResult* out) {
-  trace_block(best_packet_isa(), scene, plan, seed, block, out);
+                 SampleResult* out, GuidingTrainer* trainer) {
+  trace_block(best_packet_isa(), scene, plan, seed, block, out, trainer);
 }
 
 // The one-path tracer (integrator.h) is the packet tracer's code on one lane.

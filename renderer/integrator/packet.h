@@ -57,12 +57,14 @@ std::string_view packet_isa_name(PacketIsa isa);
 int packet_lanes(PacketIsa isa);  // paths traced together
 
 // Renders every sample of the block; out[(pixel row-major within the block) * spp + k]
-// receives sample first_sample + k.
+// receives sample first_sample + k. With `trainer`, every diffuse vertex's
+// incident light is recorded into it as the paths end (guiding.h): the
+// samples are the same.
 void trace_block(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed, const SampleBlock& block,
-                 SampleResult* out);
+                 SampleResult* out, GuidingTrainer* trainer = nullptr);
 // The same with a given instruction set (tests compare them); it must be available.
 void trace_block(PacketIsa isa, const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,
-                 const SampleBlock& block, SampleResult* out);
+                 const SampleBlock& block, SampleResult* out, GuidingTrainer* trainer = nullptr);
 
 // The sampling plan's draw at diffuse shading points, `packet_lanes` at a
 // time through the very code the packet tracer renders with (for the

@@ -73,7 +73,7 @@ namespace pdflab {
 #define PDFLAB_PACKET_KERNEL_ENTRIES                                                                         \
   int lane_count();                                                                                          \
   void trace_block_impl(const Scene& scene, const SamplingPlan& plan, std::uint64_t seed,                    \
-                        const SampleBlock& block, SampleResult* out);                                        \
+                        const SampleBlock& block, SampleResult* out, GuidingTrainer* trainer);               \
   void sample_plan_impl(const SamplingPlan& plan, const PlanDraw* draws, std::size_t n, DirectionSample* out); \
   void plan_pdf_impl(const SamplingPlan& plan, const PlanDraw* draws, const Vec3* directions, std::size_t n,  \
                      float* out);                                                                            \

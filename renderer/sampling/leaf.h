@@ -4,6 +4,7 @@
 // (renderer/integrator/kernel.inc); the one-path tracer, the probe and
 // the tests call these.
 #include "renderer/math.h"
+#include "renderer/sampling/guiding.h"
 #include "renderer/sampling/light_tree.h"
 #include "renderer/scene/scene.h"
 

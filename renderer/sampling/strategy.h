@@ -4,6 +4,7 @@
 // A small value decided once per pass; nothing here allocates per ray.
 #include "renderer/math.h"
 #include "renderer/sampling/discrete.h"
+#include "renderer/sampling/guiding.h"
 #include "renderer/sampling/rng.h"
 #include "renderer/sampling/target_set.h"
 #include "renderer/sampling/technique_table.h"
@@ -178,6 +179,9 @@ struct SamplingPlan {
   // rather than the area lights (environment_light_share).
   const Environment* environment = nullptr;
   float environment_share = 0.0f;
+  // `guided`'s learned distribution (null: untrained, the uniform sphere);
+  // set by whoever trains it (RenderSession), which keeps it alive.
+  const GuidingDistribution* guiding = nullptr;
 
   // Throws InputError when the strategy needs targets the scene does not have
   // and no other technique has weight, or when a positive weight is below

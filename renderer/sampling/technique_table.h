@@ -18,6 +18,7 @@
 #include "renderer/sampling/techniques/uniform_cone.inc"
 #include "renderer/sampling/techniques/bsdf.inc"
 #include "renderer/sampling/techniques/environment.inc"
+#include "renderer/sampling/techniques/guided.inc"
 
 #elif !defined(PDFLAB_TECHNIQUE_TABLE_H)
 #define PDFLAB_TECHNIQUE_TABLE_H
@@ -33,7 +34,8 @@
   X(SpecularObjects)         \
   X(UniformCone)             \
   X(Bsdf)                    \
-  X(EnvironmentMap)
+  X(EnvironmentMap)          \
+  X(Guided)
 
 #include <array>
 #include <cstdint>

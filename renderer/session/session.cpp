@@ -19,6 +19,9 @@ using Clock = std::chrono::steady_clock;
 namespace {
 // Without published images, a sweep waits for the film to grow by 1/kSweepGrowth.
 constexpr std::uint32_t kSweepGrowth = 4;
+// The seed of path guiding's training passes: not the render's, so that no
+// sample of the render reuses the random numbers of one that trained it.
+std::uint64_t training_seed(std::uint64_t seed) { return seed ^ 0x9e3779b97f4a7c15ull; }
 }  // namespace
 
 RenderSession::RenderSession(int threads) { start_workers(threads); }
@@ -105,6 +108,19 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   }
   noise_ = NoiseSummary{};
   next_sweep_spp_ = 0;
+  // guided:PASSES trains anew for each generation (a resumed film too: the
+  // training depends on the scene, the strategy and the seed alone, so it
+  // learns the distribution the film was rendered with).
+  const int guided = static_cast<int>(Technique::Guided);
+  training_passes_ = plan_.weight[guided] > 0.0f ? static_cast<int>(std::lround(plan_.parameter[guided])) : 0;
+  training_done_ = 0;
+  trainer_.reset();
+  guide_.reset();
+  if (training_passes_ > 0) {
+    trainer_ = std::make_unique<GuidingTrainer>(*settings_.scene);
+    guide_ = trainer_->distribution();
+  }
+  plan_.guiding = guide_.get();
   running_clock_ = false;
   next_pass_spp_ = 1;
   preview_due_ = options_.preview;
@@ -155,17 +171,22 @@ void RenderSession::start_pass_locked() {
   pass_.preview_scale = scale;
   pass_.width = (cam.width + scale - 1) / scale;
   pass_.height = (cam.height + scale - 1) / scale;
+  pass_.training = !pass_.preview && training_done_ < training_passes_;
+  pass_.seed = pass_.training ? training_seed(settings_.seed) : settings_.seed;
   if (pass_.preview) {
     pass_.first_sample = 0;
     pass_.spp = 1;
     preview_.assign(3 * static_cast<std::size_t>(pass_.width) * static_cast<std::size_t>(pass_.height), 0.0f);
+  } else if (pass_.training) {
+    pass_.first_sample = 0;
+    pass_.spp = 1u << training_done_;
   } else {
     pass_.first_sample = settings_.first_sample + spp_done_;
     pass_.spp = spp;
   }
   pass_.tiles_x = (pass_.width + kTile - 1) / kTile;
   pass_.tiles = pass_.tiles_x * ((pass_.height + kTile - 1) / kTile);
-  pass_.sweep = !pass_.preview && (options_.publish_images || spp_done_ + pass_.spp >= next_sweep_spp_);
+  pass_.sweep = !pass_.preview && (options_.publish_images || (!pass_.training && spp_done_ + pass_.spp >= next_sweep_spp_));
   if (pass_.sweep) {
     tile_noise_.assign(static_cast<std::size_t>(pass_.tiles), NoiseSums{});
     if (options_.publish_images) {  // every pixel is written by its tile's sweep
@@ -208,6 +229,11 @@ void RenderSession::finish_pass_locked() {
     done_cv_.notify_all();
     return;
   }
+  if (pass_.training) {
+    finish_training_locked();
+    done_cv_.notify_all();
+    return;
+  }
   spp_done_ += pass_.spp;
   const std::uint64_t pass_samples = static_cast<std::uint64_t>(pass_.spp) * film_.pixel_count();
   samples_done_ += pass_samples;
@@ -244,12 +270,40 @@ void RenderSession::finish_pass_locked() {
   done_cv_.notify_all();
 }
 
+void RenderSession::finish_training_locked() {
+  // What the pass recorded becomes the next distribution, which the next
+  // pass (or the render) samples with; the pass's image is shown, then cleared.
+  trainer_->finish_pass();
+  guide_ = trainer_->distribution();
+  plan_.guiding = guide_.get();
+  ++training_done_;
+  if (pass_.sweep) {
+    NoiseSums sums;
+    for (const NoiseSums& tile : tile_noise_) sums.add(tile);
+    noise_ = sums.summary();
+  }
+  if (options_.publish_images) {
+    spare_drops_ = film_.drop_masks();
+    publish_locked(spare_rgb_, pass_);
+  }
+  film_.clear();
+  drops_ = DropCounts{};
+  noise_ = NoiseSummary{};
+  if (paused_) {
+    seconds_before_ += std::chrono::duration<double>(Clock::now() - resumed_at_).count();
+    running_clock_ = false;
+  } else {
+    start_pass_locked();
+  }
+}
+
 void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {
   ImageInfo info;
   info.width = settings_.scene->camera.width;
   info.height = settings_.scene->camera.height;
   info.generation = pass.generation;
-  info.spp = pass.preview ? 0 : spp_done_;
+  info.spp = pass.preview ? 0 : pass.training ? pass.spp : spp_done_;
+  info.training_pass = pass.training ? training_done_ : 0;
   info.seconds = elapsed_locked();
   info.preview = pass.preview;
   info.preview_scale = pass.preview ? pass.preview_scale : 1;
@@ -336,7 +390,7 @@ void RenderSession::render_tiles(const Pass& pass, int first, int count, DropCou
   constexpr std::size_t kChunk = 4096;
   std::array<SampleResult, kChunk> results;
   const auto add = [&](const SampleBlock& block) {
-    trace_block(scene, plan_, settings_.seed, block, results.data());
+    trace_block(scene, plan_, pass.seed, block, results.data(), pass.training ? trainer_.get() : nullptr);
     const SampleResult* r = results.data();
     for (int y = block.y0; y < block.y1; ++y) {
       for (int x = block.x0; x < block.x1; ++x) {
@@ -442,6 +496,11 @@ double RenderSession::elapsed_locked() const {
   return s;
 }
 
+std::shared_ptr<const GuidingDistribution> RenderSession::guiding() const {
+  std::lock_guard lk(mutex_);
+  return pending_ ? nullptr : guide_;
+}
+
 SessionStats RenderSession::stats() const {
   std::lock_guard lk(mutex_);
   SessionStats st;
@@ -467,6 +526,10 @@ SessionStats RenderSession::stats() const {
   if (settings_.target_seconds > 0.0) st.progress = std::max(st.progress, std::min(1.0, st.seconds / settings_.target_seconds));
   st.dropped = drops_;
   st.estimated_relmse = noise_.estimated_relmse;
+  st.guiding_passes = training_passes_;
+  st.guiding_pass = training_done_;
+  if (trainer_) st.guiding_records = trainer_->records();
+  if (guide_) st.guiding = guide_->stats();
   return st;
 }
 

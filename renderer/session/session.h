@@ -60,6 +60,11 @@ struct SessionStats {
   double estimated_relmse = 0.0;
   bool done = false;               // target_spp or target_seconds reached
   bool paused = false;
+  // Path guiding (a strategy with `guided`): the training passes ended and
+  // asked for, the records they took, and the distribution rendered with.
+  int guiding_pass = 0, guiding_passes = 0;
+  std::uint64_t guiding_records = 0;
+  GuidingDistribution::Stats guiding;
 };
 
 // What copy_image published: a complete pass, or a preview after a change.
@@ -78,6 +83,9 @@ struct ImageInfo {
   // they need no reference, so a viewer can show them from the first pass on.
   double mean_relative_standard_error = 0.0;
   double estimated_relmse = 0.0;
+  // A path guiding training pass (1, 2, ...; 0: none): its spp samples were
+  // rendered while the distribution was still learning and are then discarded.
+  int training_pass = 0;
 };
 
 // A published pass with the per-pixel layers a viewer shows beside the mean.
@@ -138,6 +146,9 @@ class RenderSession {
   std::uint64_t generation() const { return generation_.load(); }
 
   SessionStats stats() const;
+  // Path guiding's distribution as learned so far (null: the strategy has no
+  // `guided`): what the render draws from once its training passes are done.
+  std::shared_ptr<const GuidingDistribution> guiding() const;
   int thread_count() const { return static_cast<int>(workers_.size()); }
 
   // Blocks until target_spp or target_seconds is reached (true) or the timeout passes (false).
@@ -175,6 +186,8 @@ class RenderSession {
     int preview_scale = 1;  // preview pixel = preview_scale x preview_scale image pixels
     int width = 0, height = 0;  // of the grid the tiles cover
     bool sweep = false;  // a full pass whose tiles are swept for the noise figures
+    bool training = false;  // a path guiding training pass: recorded, then discarded
+    std::uint64_t seed = 0;  // of its samples
   };
 
   void start_workers(int threads);
@@ -192,6 +205,7 @@ class RenderSession {
   void publish_film_locked();  // the whole film as a complete pass of this generation
   int preview_scale_locked() const;
   void finish_pass_locked();
+  void finish_training_locked();  // a training pass ends (finish_pass_locked)
   void change_settings(RenderSettings settings, std::optional<FilmStart> start);
   void apply_settings_locked(RenderSettings settings, const SamplingPlan& plan, std::optional<FilmStart> start);
   void wait_idle_locked(std::unique_lock<std::mutex>& lk, const char* caller) const;
@@ -248,6 +262,18 @@ class RenderSession {
   std::atomic<std::uint64_t> tiles_finished_{0};  // in the open pass, for progress
 
   Film film_;  // tiles written by workers without the lock (disjoint)
+
+  // Path guiding (guiding.h), for a strategy with `guided`: the generation's
+  // training passes (`guided:PASSES`), of 1, 2, 4, ... samples per pixel, each
+  // rendered with the distribution learned so far and recorded into the
+  // trainer, its image then cleared from the film: the render proper starts
+  // with the distribution frozen. The passes draw from their own seed, so no
+  // sample of the render shares its random numbers with one that trained it.
+  // Its clock counts the training (a time limit applies from the first kept
+  // pass on), and its samples count only the kept ones.
+  std::unique_ptr<GuidingTrainer> trainer_;
+  std::shared_ptr<const GuidingDistribution> guide_;
+  int training_passes_ = 0, training_done_ = 0;
 
   mutable std::mutex image_mutex_;
   std::vector<float> image_;

@@ -1,0 +1,349 @@
+#include "renderer/sampling/guiding.h"
+
+#include "renderer/sampling/leaf.h"
+#include "renderer/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace pdflab {
+
+namespace {
+
+// Below 1 in double: a rescaled random number is kept below this.
+constexpr double kBelowOne = 1.0 - 0x1.0p-53;
+// A record's units at most: 2^24 of the brightest emission's, so 2^24 records
+// of that size still fit a slot.
+constexpr double kMostUnits = 0x1.0p40;
+
+const GuidingDistribution::QuadNode kUniformRoot{{1.0f, 1.0f, 1.0f, 1.0f}, {0, 0, 0, 0}, 0.5f, {0.5f, 0.5f}};
+
+// The quadrant of (s, t) in a node's square, and (s, t) in that quadrant's.
+int quadrant(double& s, double& t) {
+  const int x = s >= 0.5 ? 1 : 0, y = t >= 0.5 ? 1 : 0;
+  s = std::min(2.0 * s - x, kBelowOne);
+  t = std::min(2.0 * t - y, kBelowOne);
+  return x + 2 * y;
+}
+
+}  // namespace
+
+SquarePoint square_from_direction(const Vec3& direction) {
+  SquarePoint p;
+  leaf::guide_square(direction, p.s, p.t);
+  return p;
+}
+
+Vec3 direction_from_square(float s, float t) { return leaf::guide_direction(s, t); }
+
+// ---- GuidingDistribution ---------------------------------------------------------
+
+void GuidingDistribution::QuadNode::derive() {
+  double p[4];
+  for (int c = 0; c < 4; ++c) p[c] = 0.25 * factor[c];
+  left = static_cast<float>(p[0] + p[2]);
+  for (int x = 0; x < 2; ++x) {
+    const double column = p[x] + p[x + 2];
+    low[x] = column > 0.0 ? static_cast<float>(p[x] / column) : 0.5f;
+  }
+}
+
+GuidingDistribution::GuidingDistribution(const Vec3& lo, const Vec3& hi)
+    : lo_(lo), hi_(hi), nodes_{kUniformRoot}, roots_(kGuidingNormalBins, 0) {
+  for (int k = 0; k < kGuidingNormalBins; ++k) spatial_.push_back({-1, 0.0f, 0, k});
+}
+
+int guiding_normal_bin(const Vec3& normal) { return leaf::guide_normal_bin(normal); }
+
+int GuidingDistribution::leaf_at(const Vec3& point, const Vec3& normal) const {
+  auto i = static_cast<std::size_t>(guiding_normal_bin(normal));
+  while (spatial_[i].axis >= 0) {
+    const SpatialNode& n = spatial_[i];
+    i = static_cast<std::size_t>(n.child + (point[n.axis] >= n.split ? 1 : 0));
+  }
+  return spatial_[i].leaf;
+}
+
+void GuidingDistribution::leaf_box(int leaf, Vec3& lo, Vec3& hi) const {
+  const std::function<bool(std::size_t, Vec3, Vec3)> walk = [&](std::size_t i, Vec3 a, Vec3 b) {
+    const SpatialNode& n = spatial_[i];
+    if (n.axis < 0) {
+      if (n.leaf != leaf) return false;
+      lo = a, hi = b;
+      return true;
+    }
+    Vec3 mid_hi = b, mid_lo = a;
+    mid_hi[n.axis] = n.split;
+    mid_lo[n.axis] = n.split;
+    return walk(static_cast<std::size_t>(n.child), a, mid_hi) || walk(static_cast<std::size_t>(n.child + 1), mid_lo, b);
+  };
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kGuidingNormalBins); ++k)
+    if (walk(k, lo_, hi_)) return;
+}
+
+GuidingDistribution::Sample GuidingDistribution::sample(const Vec3& point, const Vec3& normal, float u1,
+                                                        float u2) const {
+  Sample s;
+  leaf::guide_sample(*this, leaf::guide_root(*this, point, normal, true), u1, u2, true, s.direction, s.pdf);
+  return s;
+}
+
+float GuidingDistribution::pdf(const Vec3& point, const Vec3& normal, const Vec3& direction) const {
+  const SquarePoint p = square_from_direction(direction);
+  return leaf::guide_density(*this, leaf::guide_root(*this, point, normal, true), p.s, p.t, true);
+}
+
+std::vector<Vec3> GuidingDistribution::density_edges(const Vec3& point, const Vec3& normal, int per_edge) const {
+  std::vector<Vec3> out;
+  const std::function<void(std::int32_t, double, double, double)> cells = [&](std::int32_t at, double ox, double oy,
+                                                                             double size) {
+    const QuadNode& n = node(at);
+    const double half = 0.5 * size;
+    // The node's two inner edges, where its quadrants meet.
+    for (int k = 0; k <= per_edge; ++k) {
+      const double f = (k + 0.5) / (per_edge + 1);
+      out.push_back(direction_from_square(static_cast<float>(ox + half), static_cast<float>(oy + f * size)));
+      out.push_back(direction_from_square(static_cast<float>(ox + f * size), static_cast<float>(oy + half)));
+    }
+    for (int c = 0; c < 4; ++c)
+      if (n.child[c]) cells(n.child[c], ox + (c & 1) * half, oy + (c >> 1) * half, half);
+  };
+  cells(root(leaf_at(point, normal)), 0.0, 0.0, 1.0);
+  return out;
+}
+
+GuidingDistribution::Stats GuidingDistribution::stats() const {
+  Stats s;
+  s.leaves = leaves();
+  s.nodes = nodes_.size();
+  s.bytes = spatial_.size() * sizeof(SpatialNode) + nodes_.size() * sizeof(QuadNode) +
+            roots_.size() * sizeof(std::int32_t);
+  const std::function<int(std::int32_t)> depth = [&](std::int32_t at) {
+    int deepest = 0;
+    for (int c = 0; c < 4; ++c)
+      if (node(at).child[c]) deepest = std::max(deepest, depth(node(at).child[c]));
+    return deepest + 1;
+  };
+  for (const std::int32_t r : roots_) s.max_depth = std::max(s.max_depth, depth(r));
+  return s;
+}
+
+// ---- GuidingTrainer --------------------------------------------------------------
+
+namespace {
+
+// The box around the scene's objects, a little larger: its low corner, or its high one.
+Vec3 scene_box(const Scene& scene, bool high) {
+  Vec3 lo(std::numeric_limits<float>::max());
+  Vec3 hi(-std::numeric_limits<float>::max());
+  const auto grow = [&](const Vec3& p) {
+    lo = min(lo, p);
+    hi = max(hi, p);
+  };
+  for (const Quad& q : scene.quads) {
+    grow(q.q);
+    grow(q.q + q.u);
+    grow(q.q + q.v);
+    grow(q.q + q.u + q.v);
+  }
+  for (const Sphere& s : scene.spheres) {
+    grow(s.center - Vec3(s.radius));
+    grow(s.center + Vec3(s.radius));
+  }
+  if (lo.x > hi.x) lo = hi = Vec3(0.0f);
+  const Vec3 margin = (hi - lo) * 1e-3f + Vec3(1e-6f);
+  return high ? hi + margin : lo - margin;
+}
+
+// The scene's brightest emission (1 where nothing emits).
+double brightest_emission(const Scene& scene) {
+  double most = 0.0;
+  for (const Material& m : scene.materials) most = std::max(most, luminance(m.emit.x, m.emit.y, m.emit.z));
+  return most > 0.0 ? most : 1.0;
+}
+
+}  // namespace
+
+GuidingTrainer::GuidingTrainer(const Scene& scene)
+    : GuidingTrainer(scene_box(scene, false), scene_box(scene, true), 0x1.0p24 / brightest_emission(scene)) {}
+
+GuidingTrainer::GuidingTrainer(const Vec3& lo, const Vec3& hi, double scale)
+    : scale_(scale), leaves_(kGuidingNormalBins) {
+  for (int k = 0; k < kGuidingNormalBins; ++k) {
+    spatial_.push_back({-1, 0.0f, 0, k});
+    leaves_[static_cast<std::size_t>(k)].nodes.push_back(CollectNode{{0, 0, 0, 0}, {0, 0, 0, 0}});
+  }
+  current_ = std::make_shared<GuidingDistribution>(lo, hi);
+}
+
+GuidingTrainer::~GuidingTrainer() = default;
+
+void GuidingTrainer::record(const Vec3& point, const Vec3& normal, const Vec3& direction, double energy) {
+  auto i = static_cast<std::size_t>(guiding_normal_bin(normal));
+  while (spatial_[i].axis >= 0) {
+    const GuidingDistribution::SpatialNode& n = spatial_[i];
+    i = static_cast<std::size_t>(n.child + (point[n.axis] >= n.split ? 1 : 0));
+  }
+  Leaf& leaf = leaves_[static_cast<std::size_t>(spatial_[i].leaf)];
+  std::atomic_ref<std::uint64_t>(leaf.count).fetch_add(1, std::memory_order_relaxed);
+  if (!(energy > 0.0)) return;  // no light (or not a number): counted, nothing added
+  const double units = std::min(std::floor(energy * scale_ + 0.5), kMostUnits);
+  if (units >= 1.0) collect(leaf, square_from_direction(direction), static_cast<std::uint64_t>(units));
+}
+
+void GuidingTrainer::collect(Leaf& leaf, const SquarePoint& p, std::uint64_t units) {
+  double s = p.s, t = p.t;
+  std::int32_t node = 0;
+  for (;;) {
+    CollectNode& n = leaf.nodes[static_cast<std::size_t>(node)];
+    const int c = quadrant(s, t);
+    if (n.child[c] == 0) {
+      std::atomic_ref<std::uint64_t>(n.energy[c]).fetch_add(units, std::memory_order_relaxed);
+      return;
+    }
+    node = n.child[c];
+  }
+}
+
+void GuidingTrainer::finish_pass() {
+  // 1. Each quadrant's energy: its own where it is a leaf cell, its subtree's otherwise.
+  for (Leaf& leaf : leaves_) {
+    const std::function<std::uint64_t(std::int32_t)> total = [&](std::int32_t node) {
+      std::uint64_t sum = 0;
+      for (int c = 0; c < 4; ++c) {
+        CollectNode& n = leaf.nodes[static_cast<std::size_t>(node)];
+        if (n.child[c]) {
+          const std::uint64_t below = total(n.child[c]);
+          leaf.nodes[static_cast<std::size_t>(node)].energy[c] = below;
+        }
+        sum += leaf.nodes[static_cast<std::size_t>(node)].energy[c];
+      }
+      return sum;
+    };
+    total(0);
+  }
+  for (const Leaf& leaf : leaves_) records_total_ += leaf.count;
+
+  // 2. The S-tree: a leaf with too many records splits across its longest side.
+  const double threshold = kGuidingSpatialThreshold * std::sqrt(std::ldexp(1.0, passes_));
+  std::vector<GuidingDistribution::SpatialNode> spatial(static_cast<std::size_t>(kGuidingNormalBins));
+  std::vector<Leaf> leaves;
+  const std::function<void(std::size_t, const Leaf&, std::uint64_t, Vec3, Vec3, int)> place =
+      [&](std::size_t at, const Leaf& leaf, std::uint64_t count, Vec3 lo, Vec3 hi, int depth) {
+        const Vec3 size = hi - lo;
+        const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+        if (static_cast<double>(count) > threshold && depth < 40) {
+          const float split = 0.5f * (lo[axis] + hi[axis]);
+          if (split > lo[axis] && split < hi[axis]) {
+            const auto child = static_cast<std::int32_t>(spatial.size());
+            spatial[at] = {axis, split, child, -1};
+            spatial.resize(spatial.size() + 2);
+            Vec3 mid_hi = hi, mid_lo = lo;
+            mid_hi[axis] = split;
+            mid_lo[axis] = split;
+            place(static_cast<std::size_t>(child), leaf, count / 2, lo, mid_hi, depth + 1);
+            place(static_cast<std::size_t>(child) + 1, leaf, count - count / 2, mid_lo, hi, depth + 1);
+            return;
+          }
+        }
+        spatial[at] = {-1, 0.0f, 0, static_cast<std::int32_t>(leaves.size())};
+        leaves.push_back(leaf);
+        leaves.back().count = count;
+      };
+  const std::function<void(std::size_t, std::size_t, Vec3, Vec3, int)> rebuild = [&](std::size_t old, std::size_t at,
+                                                                                      Vec3 lo, Vec3 hi, int depth) {
+    const GuidingDistribution::SpatialNode& n = spatial_[old];
+    if (n.axis < 0) {
+      const Leaf& leaf = leaves_[static_cast<std::size_t>(n.leaf)];
+      place(at, leaf, leaf.count, lo, hi, depth);
+      return;
+    }
+    const auto child = static_cast<std::int32_t>(spatial.size());
+    spatial[at] = {n.axis, n.split, child, -1};
+    spatial.resize(spatial.size() + 2);
+    Vec3 mid_hi = hi, mid_lo = lo;
+    mid_hi[n.axis] = n.split;
+    mid_lo[n.axis] = n.split;
+    rebuild(static_cast<std::size_t>(n.child), static_cast<std::size_t>(child), lo, mid_hi, depth + 1);
+    rebuild(static_cast<std::size_t>(n.child) + 1, static_cast<std::size_t>(child) + 1, mid_lo, hi, depth + 1);
+  };
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kGuidingNormalBins); ++k)
+    rebuild(k, k, current_->lo(), current_->hi(), 0);
+
+  // 3. The next distribution: each leaf's energies as shares.
+  auto next = std::shared_ptr<GuidingDistribution>(new GuidingDistribution());
+  next->lo_ = current_->lo();
+  next->hi_ = current_->hi();
+  next->roots_.resize(leaves.size());
+  for (std::size_t k = 0; k < leaves.size(); ++k) {
+    const std::vector<CollectNode>& nodes = leaves[k].nodes;
+    const auto first = static_cast<std::int32_t>(next->nodes_.size());
+    next->roots_[k] = first;
+    const CollectNode& root = nodes[0];
+    if (root.energy[0] + root.energy[1] + root.energy[2] + root.energy[3] == 0) {
+      next->nodes_.push_back(kUniformRoot);
+      continue;
+    }
+    for (const CollectNode& n : nodes) {
+      const double sum = static_cast<double>(n.energy[0]) + static_cast<double>(n.energy[1]) +
+                         static_cast<double>(n.energy[2]) + static_cast<double>(n.energy[3]);
+      GuidingDistribution::QuadNode q{};
+      for (int c = 0; c < 4; ++c) {
+        q.factor[c] = sum > 0.0 ? static_cast<float>(4.0 * static_cast<double>(n.energy[c]) / sum) : 1.0f;
+        q.child[c] = n.child[c] ? first + n.child[c] : 0;
+      }
+      q.derive();
+      next->nodes_.push_back(q);
+    }
+  }
+  for (GuidingDistribution::SpatialNode& n : spatial)
+    if (n.axis < 0) n.child = next->roots_[static_cast<std::size_t>(n.leaf)];
+  next->spatial_ = spatial;
+
+  // 4. The D-trees the next pass records into: cells above kGuidingSplitShare
+  // of their leaf's energy split (where a cell was a leaf, its energy is
+  // taken as spread evenly over its quadrants), the rest merged; energies reset.
+  for (Leaf& leaf : leaves) {
+    const CollectNode& root = leaf.nodes[0];
+    const double leaf_total = static_cast<double>(root.energy[0]) + static_cast<double>(root.energy[1]) +
+                              static_cast<double>(root.energy[2]) + static_cast<double>(root.energy[3]);
+    std::vector<CollectNode> refined;
+    // A node for a square holding `energy[c]` in its quadrants (`old`: its node
+    // in the old tree, -1: none, the energy spread evenly), at `depth`.
+    const std::function<std::int32_t(std::int32_t, const double*, int)> build = [&](std::int32_t old,
+                                                                                      const double* energy, int depth) {
+      const auto index = static_cast<std::int32_t>(refined.size());
+      refined.push_back(CollectNode{{0, 0, 0, 0}, {0, 0, 0, 0}});
+      for (int c = 0; c < 4; ++c) {
+        if (!(leaf_total > 0.0) || energy[c] / leaf_total <= kGuidingSplitShare || depth + 1 >= kGuidingMaxDepth)
+          continue;
+        double below[4];
+        std::int32_t old_child = -1;
+        if (old >= 0 && leaf.nodes[static_cast<std::size_t>(old)].child[c]) {
+          old_child = leaf.nodes[static_cast<std::size_t>(old)].child[c];
+          for (int k = 0; k < 4; ++k)
+            below[k] = static_cast<double>(leaf.nodes[static_cast<std::size_t>(old_child)].energy[k]);
+        } else {
+          for (double& b : below) b = 0.25 * energy[c];
+        }
+        const std::int32_t child = build(old_child, below, depth + 1);
+        refined[static_cast<std::size_t>(index)].child[c] = child;
+      }
+      return index;
+    };
+    const double energy[4] = {static_cast<double>(root.energy[0]), static_cast<double>(root.energy[1]),
+                              static_cast<double>(root.energy[2]), static_cast<double>(root.energy[3])};
+    build(0, energy, 0);
+    leaf.nodes = std::move(refined);
+    leaf.count = 0;
+  }
+
+  spatial_ = std::move(spatial);
+  leaves_ = std::move(leaves);
+  current_ = std::move(next);
+  ++passes_;
+}
+
+}  // namespace pdflab

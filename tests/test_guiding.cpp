@@ -1,0 +1,233 @@
+// Path guiding (renderer/sampling/guiding.h, the `guided` technique): the
+// cylindrical map, the SD-tree's density against its sampler (chi-square, the
+// density integrating to one) untrained and at several trained states, what
+// it learns from known light, the training's independence from the thread
+// count, and the guided mixtures' images against cosine's.
+#include "renderer/integrator/packet.h"
+#include "renderer/metrics/chi_square.h"
+#include "renderer/metrics/statistics.h"
+#include "renderer/sampling/guiding.h"
+#include "renderer/scene/scene_loader.h"
+#include "tests/render_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace pdflab {
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+
+TEST(GuidingMap, CylindricalMapRoundTripsAndPreservesArea) {
+  Rng rng(3, 5);
+  for (int i = 0; i < 100000; ++i) {
+    const float s = rng.uniform(), t = rng.uniform();
+    const Vec3 d = direction_from_square(s, t);
+    ASSERT_NEAR(length(d), 1.0f, 1e-6f);
+    const SquarePoint p = square_from_direction(d);
+    ASSERT_NEAR(p.s, s, 1e-6) << i;
+    // t wraps at 1: compared on the circle, as a distance on the sphere
+    // (the azimuth of a direction near a pole is as uncertain as it is near).
+    const double dt = std::fabs(static_cast<double>(p.t) - t);
+    const double r = std::sqrt(std::max(0.0, 1.0 - static_cast<double>(d.z) * d.z));
+    ASSERT_LT(2.0 * kPi * std::min(dt, 1.0 - dt) * r, 1e-6) << i;
+  }
+  // Area preservation: the square's lower half is the lower hemisphere, a
+  // band of s of width w is a band of z of width 2w (Archimedes).
+  EXPECT_NEAR(direction_from_square(0.5f, 0.3f).z, 0.0f, 1e-7f);
+  EXPECT_NEAR(direction_from_square(0.75f, 0.3f).z, 0.5f, 1e-7f);
+}
+
+// Records drawn uniformly over the sphere, of energy `bright` within
+// `degrees` of `towards` and 1 elsewhere, at points spread over the box.
+void teach(GuidingTrainer& trainer, const Vec3& towards, double degrees, double bright, int records,
+           std::uint64_t seed) {
+  Rng rng(seed, 7);
+  const double cos_cone = std::cos(degrees * kPi / 180.0);
+  for (int i = 0; i < records; ++i) {
+    const Vec3 d = direction_from_square(rng.uniform(), rng.uniform());
+    const Vec3 p(rng.uniform(), rng.uniform(), rng.uniform());
+    const double energy = dot(d, towards) >= cos_cone ? bright : 1.0;
+    trainer.record(p, Vec3(0.0f, 0.0f, 1.0f), d, energy * 4.0 * kPi);  // radiance over the uniform density
+  }
+  trainer.finish_pass();
+}
+
+// Where the density jumps: the edges of the D-tree's cells at `point`, about +z.
+std::vector<chi_square::Point> dtree_edges(const GuidingDistribution& g, const Vec3& point,
+                                           const chi_square::Frame& frame) {
+  std::vector<chi_square::Point> out;
+  for (const Vec3& d : g.density_edges(point, Vec3(0.0f, 0.0f, 1.0f), 48)) out.push_back(frame.coordinates(d));
+  return out;
+}
+
+// The distribution's own sampler against its density at `point`: chi-square
+// on a grid that the top cells align with, and the density's integral.
+void expect_sampler_follows_density(const GuidingDistribution& g, const Vec3& point, std::uint64_t seed) {
+  const chi_square::Frame frame(Vec3(0.0f, 0.0f, 1.0f));
+  const chi_square::Grid grid(16, 32);
+  const chi_square::Draw draw = [&](Rng& rng) {
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const GuidingDistribution::Sample s = g.sample(point, Vec3(0.0f, 0.0f, 1.0f), u1, u2);
+    return DirectionSample{s.direction, s.pdf};
+  };
+  const chi_square::Density density = [&](const Vec3& d) { return static_cast<double>(g.pdf(point, Vec3(0.0f, 0.0f, 1.0f), d)); };
+  const chi_square::Outcome o = chi_square::run(grid, frame, draw, density, dtree_edges(g, point, frame), seed, 400000);
+  EXPECT_NEAR(o.integral, 1.0, 2e-3);
+  EXPECT_EQ(o.bad_pdf, 0u);
+  EXPECT_EQ(o.pdf_mismatch, 0u);
+  EXPECT_TRUE(o.passed(1e-3)) << "p = " << o.chi.p_value << ", zero-cell hits " << o.chi.zero_cell_hits;
+}
+
+TEST(GuidingDistribution, UntrainedIsTheUniformSphere) {
+  const GuidingDistribution g(Vec3(0.0f), Vec3(1.0f));
+  EXPECT_EQ(g.leaves(), kGuidingNormalBins);
+  Rng rng(1, 1);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 d = direction_from_square(rng.uniform(), rng.uniform());
+    EXPECT_FLOAT_EQ(g.pdf(Vec3(0.5f), d, d), static_cast<float>(1.0 / (4.0 * kPi)));
+  }
+  expect_sampler_follows_density(g, Vec3(0.5f), 11);
+}
+
+TEST(GuidingTrainer, LearnsWhereTheLightComesFrom) {
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
+  const Vec3 towards = normalize(Vec3(0.3f, -0.5f, 0.8f));
+  // A cone of 12 degrees 200 times brighter than the rest: it holds
+  // 200 (1 - cos 12) / (200 (1 - cos 12) + (1 + cos 12)) of the light.
+  const double c = std::cos(12.0 * kPi / 180.0);
+  const double share = 200.0 * (1.0 - c) / (200.0 * (1.0 - c) + (1.0 + c));
+  for (int pass = 0; pass < 3; ++pass) {
+    teach(trainer, towards, 12.0, 200.0, 400000, 100 + static_cast<std::uint64_t>(pass));
+    const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+    const Vec3 at(0.3f, 0.6f, 0.2f);
+    // The learned mass in the cone, by sampling the learned distribution.
+    Rng rng(9, 9);
+    int inside = 0;
+    constexpr int kDraws = 200000;
+    for (int i = 0; i < kDraws; ++i) inside += dot(g->sample(at, Vec3(0.0f, 0.0f, 1.0f), rng.uniform(), rng.uniform()).direction, towards) >= c;
+    const double learned = static_cast<double>(inside) / kDraws;
+    std::printf("[guiding] pass %d: %d leaves, %zu nodes, depth %d; the cone's share %.3f (true %.3f)\n", pass + 1,
+                g->stats().leaves, g->stats().nodes, g->stats().max_depth, learned, share);
+    // The cells straddling the cone's edge blur it, and a leaf learns from
+    // its own records alone (a few thousand once the S-tree has split): within
+    // 25% of the truth once the quadtree has refined around it (it starts with
+    // four cells), where the cone is 0.8% of the sphere.
+    if (pass > 0) {
+      EXPECT_NEAR(learned, share, 0.25 * share) << "pass " << pass + 1;
+    }
+    expect_sampler_follows_density(*g, at, 20 + static_cast<std::uint64_t>(pass));
+  }
+  // 1.2 million records over a pass threshold of 4000 sqrt(2^k): the S-tree split.
+  EXPECT_GT(trainer.distribution()->leaves(), 8);
+  EXPECT_EQ(trainer.passes(), 3);
+}
+
+TEST(GuidingTrainer, TheSameTreesForAnyOrderOfRecords) {
+  // Records added in two orders (as threads would) give the same distribution, bit for bit, pass after pass.
+  const Vec3 towards(0.0f, 0.0f, 1.0f);
+  GuidingTrainer a(Vec3(0.0f), Vec3(1.0f), 1e6), b(Vec3(0.0f), Vec3(1.0f), 1e6);
+  std::vector<std::pair<Vec3, Vec3>> records;
+  std::vector<double> energies;
+  Rng rng(4, 4);
+  for (int i = 0; i < 50000; ++i) {
+    const Vec3 d = direction_from_square(rng.uniform(), rng.uniform());
+    records.push_back({Vec3(rng.uniform(), rng.uniform(), rng.uniform()), d});
+    energies.push_back(dot(d, towards) > 0.9f ? 37.3 * rng.uniform() : 0.11 * rng.uniform());
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t i = 0; i < records.size(); ++i) a.record(records[i].first, towards, records[i].second, energies[i]);
+    for (std::size_t i = records.size(); i-- > 0;) b.record(records[i].first, towards, records[i].second, energies[i]);
+    a.finish_pass();
+    b.finish_pass();
+  }
+  const GuidingDistribution &ga = *a.distribution(), &gb = *b.distribution();
+  ASSERT_EQ(ga.leaves(), gb.leaves());
+  ASSERT_EQ(ga.nodes().size(), gb.nodes().size());
+  EXPECT_GT(ga.nodes().size(), 8u);
+  EXPECT_EQ(0, std::memcmp(ga.nodes().data(), gb.nodes().data(), ga.nodes().size() * sizeof(GuidingDistribution::QuadNode)));
+}
+
+// A plan mixing cosine with a trained `guided`, through both samplers (the
+// one-path code and the packet kernel), against the mixture's density.
+TEST(GuidingPlan, TrainedMixtureThroughBothSamplers) {
+  Scene scene = load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/door_ajar.json");
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
+  for (int pass = 0; pass < 2; ++pass)
+    teach(trainer, normalize(Vec3(0.6f, 0.2f, 0.7f)), 20.0, 50.0, 200000, 300 + static_cast<std::uint64_t>(pass));
+  const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+  for (const char* strategy : {"mix:cosine=0.5,guided=0.5", "guided", "nee-mis+mix:cosine=0.3,guided=0.7"}) {
+    SCOPED_TRACE(strategy);
+    SamplingPlan plan = SamplingPlan::make(Strategy::parse(strategy), scene);
+    plan.guiding = g.get();
+    const Vec3 at(0.4f, 0.5f, 0.5f), normal(0.0f, 0.0f, 1.0f);
+    const chi_square::Frame frame(normal);
+    const chi_square::Density density = [&](const Vec3& d) { return static_cast<double>(plan.pdf(at, normal, d)); };
+    std::vector<chi_square::Draw> draws = {chi_square::plan_sampler(plan, at, normal, chi_square::Sampler::OnePath),
+                                           chi_square::plan_sampler(plan, at, normal, chi_square::Sampler::Packet)};
+    const std::vector<chi_square::Outcome> outcomes =
+        chi_square::run_each(chi_square::Grid(16, 32), frame, draws, density, dtree_edges(*g, at, frame), 41, 400000);
+    for (const chi_square::Outcome& o : outcomes) {
+      EXPECT_NEAR(o.integral, 1.0, 2e-3);
+      EXPECT_EQ(o.bad_pdf, 0u);
+      EXPECT_TRUE(o.passed(1e-3)) << "p = " << o.chi.p_value << ", zero-cell hits " << o.chi.zero_cell_hits;
+    }
+    // The same draws, bit for bit, from the same numbers.
+    std::vector<PlanDraw> input(256);
+    Rng rng(8, 8);
+    for (PlanDraw& d : input) d = {at, normal, rng.next_u32(), rng.uniform(), rng.uniform(), rng.next_u32()};
+    std::vector<DirectionSample> packet(input.size());
+    sample_plan(best_packet_isa(), plan, input.data(), input.size(), packet.data());
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      const DirectionSample one =
+          plan.sample_at(at, normal, input[i].u1, input[i].u2, input[i].u0, input[i].u_choice);
+      EXPECT_EQ(one.direction, packet[i].direction) << i;
+      EXPECT_EQ(one.pdf, packet[i].pdf) << i;
+    }
+  }
+  // Alone, trained, it is biased and says why; untrained (0 passes) it is the uniform sphere.
+  EXPECT_FALSE(Strategy::parse("guided").is_unbiased());
+  EXPECT_NE(Strategy::parse("guided").bias_reason().find("learned light"), std::string::npos);
+  EXPECT_TRUE(Strategy::parse("guided:0").is_unbiased());
+  EXPECT_TRUE(Strategy::parse("mix:cosine=0.5,guided=0.5").is_unbiased());
+}
+
+std::shared_ptr<const Scene> small_door(int width, int height) {
+  auto s = std::make_shared<Scene>(load_scene_file(PDFLAB_SOURCE_DIR "/assets/scenes/door_ajar.json"));
+  s->camera.width = width;
+  s->camera.height = height;
+  s->prepare();
+  return s;
+}
+
+// The training passes record through the packet tracer from every worker at
+// once; the trees, and so the image, are the same for 1 and 2 threads.
+TEST(GuidingSession, TrainsTheSameForAnyThreadCount) {
+  const auto scene = small_door(40, 30);
+  const std::string strategy = "nee-mis+mix:cosine=0.5,guided:4=0.5";
+  const testing::Rendered one = testing::render_to_completion(scene, strategy, 4, 5, 1, std::chrono::seconds(300));
+  const testing::Rendered two = testing::render_to_completion(scene, strategy, 4, 5, 2, std::chrono::seconds(300));
+  EXPECT_EQ(one.stats.guiding_pass, 4);
+  EXPECT_EQ(one.stats.guiding_passes, 4);
+  EXPECT_GT(one.stats.guiding.nodes, 1u);
+  EXPECT_GT(one.stats.guiding_records, 40u * 30u * 15u);  // at least one vertex for each of 15 samples a pixel
+  EXPECT_EQ(one.stats.guiding.nodes, two.stats.guiding.nodes);
+  EXPECT_EQ(one.stats.guiding_records, two.stats.guiding_records);
+  EXPECT_EQ(one.stats.spp, 4u);
+  ASSERT_EQ(one.film.pixel_count(), two.film.pixel_count());
+  bool same = true;
+  for (std::size_t p = 0; p < one.film.pixel_count(); ++p) {
+    double a[3], b[3];
+    one.film.mean(p, a);
+    two.film.mean(p, b);
+    same = same && a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+  }
+  EXPECT_TRUE(same) << "1 and 2 threads gave different images";
+}
+
+}  // namespace
+}  // namespace pdflab
