@@ -80,6 +80,8 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"mix:cosine=0.5,light=0.5+sobol", 512},
       {"nee-mis+mix:cosine=0.5,light=0.5+sobol", 256},
       {"mix:cosine=0.5,light-sa=0.5+sobol+rr", 512},
+      // nee-mis continued by path guiding, trained in four passes before the render.
+      {"nee-mis+mix:cosine=0.5,guided:4=0.5", 256},
   };
   // And every technique of the table alone (where unbiased) and mixed with
   // cosine (tests/table_strategies.h); alone, a technique gets the uniform
@@ -369,6 +371,29 @@ TEST(Convergence, MaxDepthMeansTheSameForEveryStrategy) {
       for (std::size_t i = 0; i < cmp.z.size(); ++i)
         EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
     }
+  }
+}
+
+// Path guiding on the scene made for it (door_ajar.json, 24x24, paths of at
+// most 12 segments): the guided mixtures, trained as the session trains them
+// (four passes), converge to the image `fastest` gives. The light reaches the
+// near room only through the gap, so these are the paths the guided half aims at.
+TEST(Convergence, GuidedMixturesAgreeOnTheDoorScene) {
+  const char* strategies[] = {"mix:cosine=0.5,guided:4=0.5+rr:6", "nee-mis+mix:cosine=0.5,guided:4=0.5+rr:6",
+                              "nee-mis+mix:cosine=0.7,guided:6=0.3"};
+  constexpr int kSmall = 24;
+  const int tests = static_cast<int>(std::size(strategies)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
+  const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));
+  const auto scene = small_shipped_scene("door_ajar.json", 12);
+  const BlockImage reference = render_blocks("fastest", 1500, 8192, scene);
+  std::uint64_t seed = 1501;
+  for (const char* strategy : strategies) {
+    SCOPED_TRACE(strategy);
+    const Comparison cmp = compare(render_blocks(strategy, seed++, 2048, scene), reference);
+    std::printf("[convergence] door_ajar %-44s block z in [%+.2f, %+.2f] (limit %.2f)\n", strategy, cmp.most_negative,
+                cmp.most_positive, limit);
+    for (std::size_t i = 0; i < cmp.z.size(); ++i)
+      EXPECT_LT(std::fabs(cmp.z[i]), limit) << "block " << i / 3 << " channel " << i % 3;
   }
 }
 

@@ -117,3 +117,40 @@ TEST(SessionStress, ThousandChangesWhileRendering) {
   EXPECT_GE(published.load(), images);
   std::printf("changes: 1000, rejected: %d, images seen: %d of %d published\n", rejected, images, published.load());
 }
+
+// Path guiding's training passes (record from every worker at once, then the
+// last one out builds the next distribution) with settings changed in the
+// middle of training, many times: each generation trains anew from its own
+// first pass and renders only once trained (ThreadSanitizer runs this too).
+TEST(SessionStress, GuidingTrainsAnewAfterChangesMidTraining) {
+  const auto door = scene_at(PDFLAB_SOURCE_DIR "/assets/scenes/door_ajar.json", 24, 8);
+  SessionOptions options;
+  options.threads = 4;
+  options.preview = true;
+  options.preview_budget_ms = 0.05;
+  RenderSession session(options);
+  RenderSettings rs;
+  rs.scene = door;
+  rs.target_spp = 2;
+  const char* strategies[] = {"nee-mis+mix:cosine=0.5,guided:6=0.5", "mix:cosine=0.5,guided:3=0.5", "cosine"};
+  for (int change = 0; change < 40; ++change) {
+    rs.strategy = Strategy::parse(strategies[change % 3]);
+    rs.seed = static_cast<std::uint64_t>(change);
+    session.set_settings(rs);
+    std::this_thread::sleep_for(std::chrono::microseconds(300 * (change % 7)));
+  }
+  rs.strategy = Strategy::parse("nee-mis+mix:cosine=0.5,guided:4=0.5");
+  session.set_settings(rs);
+  ASSERT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
+  const SessionStats st = session.stats();
+  EXPECT_EQ(st.guiding_passes, 4);
+  EXPECT_EQ(st.guiding_pass, 4);
+  EXPECT_EQ(st.spp, 2u);
+  EXPECT_GT(st.guiding.nodes, 6u);
+  ASSERT_NE(session.guiding(), nullptr);
+  rs.strategy = Strategy::parse("cosine");
+  session.set_settings(rs);
+  ASSERT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
+  EXPECT_EQ(session.stats().guiding_passes, 0);
+  EXPECT_EQ(session.guiding(), nullptr);
+}
