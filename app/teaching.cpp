@@ -72,7 +72,9 @@ void TeachingViews::probe_at(const RenderSession& main, int x, int y, bool side_
   // In the split, a click probes the strategy of the side it lands on.
   Strategy strategy = ms.strategy;
   if (side_b && !b_running_.empty()) strategy = Strategy::parse(b_running_);
-  ui::probe_pixel(probe_, ms.scene, strategy, ms.seed, x, y);
+  // `guided` as the render drawing from it has learned it (the side's own session's in the split).
+  const RenderSession* drawn = split_.on && a_ && b_ ? (side_b ? b_.get() : a_.get()) : &main;
+  ui::probe_pixel(probe_, ms.scene, strategy, ms.seed, x, y, drawn->guiding());
   probe_generation_ = main.generation();
   probe_side_b_ = side_b;
   probe_b_ = b_running_;

@@ -629,6 +629,20 @@ void statistics_section(const ViewerSettings& settings, const UiStatus& status) 
     ImGui::Text("%llu", static_cast<unsigned long long>(st.dropped.by_reason[r]));
     if (r + 1 < kDropReasonCount) ImGui::SameLine();
   }
+  // Path guiding's training (a strategy with `guided`): where it is, and the trees it learned.
+  if (st.guiding_passes > 0) {
+    if (st.guiding_pass < st.guiding_passes)
+      ImGui::TextColored(kAmber, "path guiding: learning, training pass %d of %d (%u spp, discarded)",
+                         st.guiding_pass + 1, st.guiding_passes, 1u << st.guiding_pass);
+    else
+      ImGui::Text("path guiding: trained in %d passes (%u spp, discarded)", st.guiding_passes,
+                  (1u << st.guiding_passes) - 1u);
+    ImGui::PushStyleColor(ImGuiCol_Text, kDim);
+    ImGui::TextWrapped("  %.1f M records; the SD-tree: %d leaves, %zu quadtree nodes, %d levels deep, %.1f MiB",
+                       static_cast<double>(st.guiding_records) * 1e-6, st.guiding.leaves, st.guiding.nodes,
+                       st.guiding.max_depth, static_cast<double>(st.guiding.bytes) / (1024.0 * 1024.0));
+    ImGui::PopStyleColor();
+  }
   if (settings.stop_spp > 0) {
     char overlay[48];
     std::snprintf(overlay, sizeof overlay, "%u / %u spp", st.spp, settings.stop_spp);
@@ -686,6 +700,10 @@ void summary_header(const ViewerSettings& settings, const UiStatus& status, UiRe
   } else {
     std::snprintf(line, sizeof line, "%u spp   %s   %.2f M samples/s%s", st.spp, format_seconds(st.seconds).c_str(),
                   st.samples_per_second * 1e-6, st.done ? "   done" : (st.paused || settings.paused ? "   paused" : ""));
+    // Path guiding's training passes, before the first kept sample.
+    if (st.guiding_pass < st.guiding_passes)
+      std::snprintf(line, sizeof line, "guiding: learning, pass %d of %d   %s", st.guiding_pass + 1, st.guiding_passes,
+                    format_seconds(st.seconds).c_str());
   }
   one_line(line, ImVec4(0.92f, 0.92f, 0.95f, 1.0f));
   layout::item("summary.render");

@@ -43,8 +43,13 @@ ProbeMap make_map_of(const char* title, int w, int h, Values values) {
   return map;
 }
 
-ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h) {
-  return make_map_of(title, w, h, [&] { return pdf_map(SamplingPlan::make(strategy, scene), at, w, h, kSupersample); });
+ProbeMap make_map(const char* title, const Scene& scene, const Strategy& strategy, const ProbePoint& at, int w, int h,
+                  const GuidingDistribution* guide = nullptr) {
+  return make_map_of(title, w, h, [&] {
+    SamplingPlan plan = SamplingPlan::make(strategy, scene);
+    plan.guiding = guide;
+    return pdf_map(plan, at, w, h, kSupersample);
+  });
 }
 
 ProbeMap make_bsdf_map(const Scene& scene, const ProbePoint& at, int w, int h) {
@@ -334,7 +339,7 @@ BandHistogram cos_theta_bands(const ProbeChiSquare& chi) {
 }
 
 void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strategy& strategy, std::uint64_t seed,
-                 int x, int y) {
+                 int x, int y, std::shared_ptr<const GuidingDistribution> guide) {
   // A running check reads the old plan and scene through its own copies of the pointers.
   s.has_point = true;
   s.open = true;
@@ -350,8 +355,11 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   s.sample_target.clear();
   s.target_labels.clear();
   std::fill(s.technique_counts.begin(), s.technique_counts.end(), 0);
+  s.guide = std::move(guide);
   try {
-    s.plan = std::make_shared<const SamplingPlan>(SamplingPlan::make(strategy, *s.scene));
+    SamplingPlan plan = SamplingPlan::make(strategy, *s.scene);
+    plan.guiding = s.guide.get();
+    s.plan = std::make_shared<const SamplingPlan>(plan);
   } catch (const InputError&) {
     s.plan.reset();
   }
@@ -367,7 +375,7 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
     s.target_labels = target_labels(sc, s.plan->book_targets);
   }
   s.strategy_map = make_map("pdf of the strategy over the sphere", *s.scene, strategy,
-                            s.point, kMapWidth, kMapHeight);
+                            s.point, kMapWidth, kMapHeight, s.guide.get());
   s.light_map = make_map("light alone (the light lobe)", *s.scene, Strategy::single(Technique::Light), s.point,
                          kLobeWidth, kLobeHeight);
   s.bsdf_map = make_bsdf_map(*s.scene, s.point, kLobeWidth, kLobeHeight);

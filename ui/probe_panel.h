@@ -75,6 +75,7 @@ struct ProbeState {
   // Kept alive for the chi-square job, which reads both.
   std::shared_ptr<const Scene> scene;
   std::shared_ptr<const SamplingPlan> plan;
+  std::shared_ptr<const GuidingDistribution> guide;  // what plan->guiding points to
   std::future<ProbeChiSquare> chi_job;
   int serial = 0;      // bumped by every probe_pixel
   int chi_serial = 0;  // the probe the running check belongs to
@@ -86,8 +87,10 @@ struct ProbeState {
 
 // Computes the hit point, directions and maps for a pixel (a few milliseconds);
 // forgets any earlier chi-square result.
+// `guide`: the render's path guiding distribution, which `guided` draws from
+// (null: untrained, the uniform sphere).
 void probe_pixel(ProbeState& state, std::shared_ptr<const Scene> scene, const Strategy& strategy, std::uint64_t seed,
-                 int x, int y);
+                 int x, int y, std::shared_ptr<const GuidingDistribution> guide = nullptr);
 // Starts the chi-square check in the background (no-op while one runs).
 void start_probe_chi_square(ProbeState& state, double now);
 // Collects a finished check; true when one arrived for the current probe (a
