@@ -379,6 +379,10 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
   s.light_map = make_map("light alone (the light lobe)", *s.scene, Strategy::single(Technique::Light), s.point,
                          kLobeWidth, kLobeHeight);
   s.bsdf_map = make_bsdf_map(*s.scene, s.point, kLobeWidth, kLobeHeight);
+  s.guided_map = s.guide && strategy.uses(Technique::Guided)
+                     ? make_map("guided alone: what the SD-tree learned here", *s.scene,
+                                Strategy::single(Technique::Guided), s.point, kMapWidth, kMapHeight, s.guide.get())
+                     : ProbeMap{};
   s.bsdf_lobe = bsdf_lobe_name(*s.scene, s.point);
   s.delta_note = delta_lobe_note(*s.scene, s.point);
 }
@@ -485,6 +489,16 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
                    "pdf");
   ImGui::EndGroup();
   ImGui::TextWrapped("bsdf here: %s", s.bsdf_lobe.c_str());
+  if (!s.guided_map.values.empty()) {
+    // Path guiding's distribution at this point's leaf, as the render draws from it.
+    ImGui::BeginGroup();
+    draw_map(s.guided_map, ImVec2(map_h * 2.0f, map_h), s.log_scale);
+    ImGui::EndGroup();
+    ImGui::SameLine();
+    const double guided_top = s.guided_map.max_value;
+    draw::colour_bar(ImVec2(bar_w, map_h + line + 4.0f), s.log_scale ? guided_top * 1e-4 : 0.0, guided_top,
+                     s.log_scale, "pdf");
+  }
   ImGui::PushStyleColor(ImGuiCol_Text, kDim);
   ImGui::TextWrapped("phi across, cos(theta) from +1 (top) to -1; line: the horizon; each cell the pdf averaged over "
                      "it. Maxima: strategy %.3g, light %.3g, bsdf %.3g",

@@ -68,6 +68,9 @@ struct ProbeState {
   // technique alone: cosine at a lambertian point, GGX's visible normals at a
   // microfacet one).
   ProbeMap strategy_map, light_map, bsdf_map;
+  // `guided` alone as the render's distribution has learned it here (empty:
+  // the strategy has no trained `guided`).
+  ProbeMap guided_map;
   std::string bsdf_lobe;   // what the material's own lobe is here, in words
   std::string delta_note;  // the clicked surface is glass or metal: its delta lobe, in words
   ProbeLightChoice light_choice;  // each light's probability at the point

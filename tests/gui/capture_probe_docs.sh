@@ -10,6 +10,10 @@
 # probe after the click, default 2). docs/probe_many_lights.png (docs/many_lights.md) is
 #   PROBE_WAIT=20 PROBE_SCENE=assets/scenes/many_lights.json PROBE_STRATEGY=nee-mis+lights:tree \
 #   PROBE_OUT=docs/probe_many_lights.png tests/gui/capture_probe_docs.sh "" 8 50 80
+# docs/probe_guided.png (docs/guiding.md) is
+#   PROBE_WAIT=6 PROBE_SCENE=assets/scenes/door_ajar.json \
+#   PROBE_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" PROBE_OUT=docs/probe_guided.png \
+#   tests/gui/capture_probe_docs.sh "" 25 35 88
 # and docs/probe_light_choice.png (the README's starved box) is
 #   PROBE_WAIT=8 PROBE_SCENE=assets/scenes/starved_light.json PROBE_STRATEGY=nee-mis \
 #   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 10 30 88
