@@ -42,6 +42,38 @@ TEST(Probe, FindsTheFirstDiffuseSurface) {
   EXPECT_GE(through_glass.specular_bounces, 1);
 }
 
+// The incident light traced by brute force (what path guiding learns): a
+// density over the sphere, zero below the surface, brightest towards the lamp
+// from the book's floor, and the same for the same seed.
+TEST(Probe, IncidentLightMapIsADensityBrightestTowardsTheLamp) {
+  const Scene s = book();
+  const ProbePoint at = first_diffuse_hit(s, 50, 97);
+  ASSERT_TRUE(at.found);
+  constexpr int kW = 48, kH = 24;
+  const std::vector<float> map = incident_light_map(s, at, kW, kH, 16, 5);
+  ASSERT_EQ(map.size(), static_cast<std::size_t>(kW * kH));
+  double integral = 0.0;
+  std::size_t brightest = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    EXPECT_GE(map[i], 0.0f);
+    if (i >= map.size() / 2) {
+      EXPECT_EQ(map[i], 0.0f) << "below the surface, cell " << i;
+    }
+    integral += map[i];
+    if (map[i] > map[brightest]) brightest = i;
+  }
+  EXPECT_NEAR(integral * 4.0 * 3.141592653589793 / (kW * kH), 1.0, 1e-4);
+  // The lamp's centre in the map, against the brightest cell (the lamp spans a few cells).
+  float u = 0.0f, v = 0.0f;
+  direction_to_map(at, normalize(Vec3(278.0f, 554.0f, 279.5f) - at.point), u, v);
+  const int col = static_cast<int>(brightest % kW), row = static_cast<int>(brightest / kW);
+  int dc = std::abs(col - static_cast<int>(u * kW));
+  dc = std::min(dc, kW - dc);  // the azimuth wraps
+  EXPECT_LE(dc, 3) << "brightest column " << col << ", the lamp's " << u * kW;
+  EXPECT_LE(std::abs(row - static_cast<int>(v * kH)), 3) << "brightest row " << row << ", the lamp's " << v * kH;
+  EXPECT_EQ(map, incident_light_map(s, at, kW, kH, 16, 5));
+}
+
 TEST(Probe, DirectionsComeFromTheTechniquesInProportionToTheirWeights) {
   const Scene s = book();
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.25,light=0.75"), s);

@@ -18,6 +18,8 @@ namespace {
 
 constexpr int kProbeDirections = 400;
 constexpr int kMapWidth = 96, kMapHeight = 48;
+// Paths per map cell of the brute-force incident light (incident_light_map).
+constexpr int kIncidentPaths = 36;
 constexpr int kLobeWidth = 64, kLobeHeight = 32;
 constexpr int kChiSamples = 200000;
 
@@ -383,6 +385,17 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
                      ? make_map("guided alone: what the SD-tree learned here", *s.scene,
                                 Strategy::single(Technique::Guided), s.point, kMapWidth, kMapHeight, s.guide.get())
                      : ProbeMap{};
+  // The brute-force incident light, for comparison with what guiding learned
+  // (a job still running for an earlier probe is waited for: a few tenths of a second).
+  s.incident_map = ProbeMap{};
+  if (s.incident_job.valid()) s.incident_job.wait();
+  s.incident_job = {};
+  if (!s.guided_map.values.empty() && s.point.found) {
+    s.incident_serial = s.serial;
+    s.incident_job = std::async(std::launch::async, [scene = s.scene, at = s.point, seed] {
+      return incident_light_map(*scene, at, kMapWidth, kMapHeight, kIncidentPaths, seed);
+    });
+  }
   s.bsdf_lobe = bsdf_lobe_name(*s.scene, s.point);
   s.delta_note = delta_lobe_note(*s.scene, s.point);
 }
@@ -398,6 +411,18 @@ void start_probe_chi_square(ProbeState& s, double now) {
   });
 }
 
+// Collects the brute-force incident light when its job has finished.
+void poll_probe_incident(ProbeState& s) {
+  if (!s.incident_job.valid() || s.incident_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  std::vector<float> values = s.incident_job.get();
+  if (s.incident_serial != s.serial) return;
+  s.incident_map.title = "the light arriving here, traced by brute force";
+  s.incident_map.width = kMapWidth;
+  s.incident_map.height = kMapHeight;
+  for (float v : values) s.incident_map.max_value = std::max(s.incident_map.max_value, v);
+  s.incident_map.values = std::move(values);
+}
+
 bool poll_probe_chi_square(ProbeState& s, double now) {
   if (!s.chi_job.valid() || s.chi_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
   ProbeChiSquare result = s.chi_job.get();
@@ -410,6 +435,7 @@ bool poll_probe_chi_square(ProbeState& s, double now) {
 void draw_probe_panel(ProbeState& s, double now, float area_width, float area_height) {
   if (!s.open || !s.has_point) return;
   poll_probe_chi_square(s, now);
+  poll_probe_incident(s);
   // Over the side panel, reaching into the image area only as far as it must:
   // the image stays clickable for the next probe. Movable.
   (void)area_width, (void)area_height;
@@ -491,13 +517,20 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   ImGui::TextWrapped("bsdf here: %s", s.bsdf_lobe.c_str());
   if (!s.guided_map.values.empty()) {
     // Path guiding's distribution at this point's leaf, as the render draws from it.
+    // Beside it the light that arrives here, traced by brute force: what the
+    // learning aims at, on one colour scale.
+    const double guided_top = std::max(s.guided_map.max_value, s.incident_map.max_value);
     ImGui::BeginGroup();
-    draw_map(s.guided_map, ImVec2(map_h * 2.0f, map_h), s.log_scale);
+    draw_map(s.guided_map, ImVec2(map_h * 2.0f, map_h), s.log_scale, guided_top);
     ImGui::EndGroup();
     ImGui::SameLine();
-    const double guided_top = s.guided_map.max_value;
     draw::colour_bar(ImVec2(bar_w, map_h + line + 4.0f), s.log_scale ? guided_top * 1e-4 : 0.0, guided_top,
                      s.log_scale, "pdf");
+    if (!s.incident_map.values.empty()) {
+      draw_map(s.incident_map, ImVec2(map_h * 2.0f, map_h), s.log_scale, guided_top);
+    } else if (s.incident_running()) {
+      ImGui::TextColored(kDim, "tracing the light that arrives here (%d paths a cell)...", kIncidentPaths);
+    }
   }
   ImGui::PushStyleColor(ImGuiCol_Text, kDim);
   ImGui::TextWrapped("phi across, cos(theta) from +1 (top) to -1; line: the horizon; each cell the pdf averaged over "

@@ -71,6 +71,11 @@ struct ProbeState {
   // `guided` alone as the render's distribution has learned it here (empty:
   // the strategy has no trained `guided`).
   ProbeMap guided_map;
+  // Beside it, the light arriving here traced by brute force
+  // (incident_light_map), made in the background: what it should learn.
+  ProbeMap incident_map;
+  std::future<std::vector<float>> incident_job;
+  int incident_serial = 0;  // the probe the running job belongs to
   std::string bsdf_lobe;   // what the material's own lobe is here, in words
   std::string delta_note;  // the clicked surface is glass or metal: its delta lobe, in words
   ProbeLightChoice light_choice;  // each light's probability at the point
@@ -86,6 +91,7 @@ struct ProbeState {
   double chi_started = 0.0, chi_seconds = 0.0;
 
   bool chi_running() const { return chi_job.valid(); }
+  bool incident_running() const { return incident_job.valid(); }
 };
 
 // Computes the hit point, directions and maps for a pixel (a few milliseconds);

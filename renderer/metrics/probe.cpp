@@ -1,5 +1,7 @@
 #include "renderer/metrics/probe.h"
 
+#include "renderer/error.h"
+#include "renderer/integrator/integrator.h"
 #include "renderer/metrics/chi_square.h"
 
 #include "renderer/sampling/onb.h"
@@ -164,6 +166,46 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
 std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int width, int height, int supersample) {
   const SamplingPlan plan = SamplingPlan::make(Strategy::single(Technique::Bsdf), scene);
   return map_of(at, width, height, supersample, [&](const Vec3& d) { return plan.pdf(at.surface, at.point, at.normal, d); });
+}
+
+std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, int width, int height, int per_cell,
+                                      std::uint64_t seed) {
+  std::vector<float> out(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0f);
+  if (!at.found) return out;
+  SamplingPlan plan;
+  try {
+    plan = SamplingPlan::make(Strategy::nee(), scene);
+  } catch (const InputError&) {
+    plan = SamplingPlan::make(Strategy::single(Technique::Cosine), scene);
+  }
+  const MapFrame f(at.normal);
+  const int k = std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(std::max(1, per_cell))))));
+  double integral = 0.0;
+  DropCounts drops;
+  for (int row = 0; row < height / 2; ++row) {  // the rows above the surface (cos theta from 1 to 0)
+    for (int col = 0; col < width; ++col) {
+      Rng rng(seed, static_cast<std::uint64_t>(row) * static_cast<std::uint64_t>(width) + static_cast<std::uint64_t>(col));
+      double sum = 0.0;
+      const auto fk = static_cast<float>(k);
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+          const float z = 1.0f - 2.0f * (static_cast<float>(row) + (static_cast<float>(a) + rng.uniform()) / fk) /
+                                     static_cast<float>(height);
+          const float phi = 2.0f * kPi * (static_cast<float>(col) + (static_cast<float>(b) + rng.uniform()) / fk) /
+                            static_cast<float>(width);
+          const Vec3 light = trace_path(scene, plan, Ray{at.point, f.direction(z, phi)}, rng, drops);
+          sum += luminance(light.x, light.y, light.z);
+        }
+      const double mean = sum / (k * k);
+      out[static_cast<std::size_t>(row) * width + col] = static_cast<float>(mean);
+      integral += mean;
+    }
+  }
+  // Each cell is 4 pi / (width height) of the sphere.
+  integral *= 4.0 * std::numbers::pi / (static_cast<double>(width) * height);
+  if (!(integral > 0.0)) return std::vector<float>(out.size(), 0.0f);
+  for (float& v : out) v = static_cast<float>(v / integral);
+  return out;
 }
 
 float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction) {

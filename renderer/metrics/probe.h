@@ -54,6 +54,17 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
 // compared cell by cell; each value is the technique's pdf (per steradian).
 std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int width, int height,
                                 int supersample = 1);
+
+// The light arriving at the probe's point, traced by brute force, as a
+// density in pdf_map's layout: in each cell above the surface, `per_cell`
+// paths of nee-mis (the scene's plain estimator; cosine where it has no
+// lights) leave the point along directions spread evenly over the cell, and
+// their luminances are averaged; the map is then divided by its integral over
+// the sphere, so it is the incident light's own distribution L(w) / (integral
+// of L) — what path guiding learns to draw from. Cells below the surface: 0.
+// All zeros where no light arrives. Deterministic for a seed.
+std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, int width, int height, int per_cell,
+                                      std::uint64_t seed);
 // The bsdf technique's pdf at the probe point for one direction.
 float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction);
 // In words, what that lobe is at the probe point ("cosine lobe (lambertian)",

@@ -11,7 +11,7 @@
 #   PROBE_WAIT=20 PROBE_SCENE=assets/scenes/many_lights.json PROBE_STRATEGY=nee-mis+lights:tree \
 #   PROBE_OUT=docs/probe_many_lights.png tests/gui/capture_probe_docs.sh "" 8 50 80
 # docs/probe_guided.png (docs/guiding.md) is
-#   PROBE_WAIT=6 PROBE_SCENE=assets/scenes/door_ajar.json \
+#   PROBE_WAIT=8 PROBE_SCROLL=10 PROBE_SCENE=assets/scenes/door_ajar.json \
 #   PROBE_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" PROBE_OUT=docs/probe_guided.png \
 #   tests/gui/capture_probe_docs.sh "" 25 35 88
 # and docs/probe_light_choice.png (the README's starved box) is
@@ -40,6 +40,14 @@ sleep 0.5
 xdotool mousemove "$((left + w * px / 100))" "$((top + h * py / 100))" click 1
 xdotool mousemove 2 2
 sleep "${PROBE_WAIT:-2}"  # the probe's figures are made before it shows
+# PROBE_SCROLL: wheel clicks down over the probe's window, to show its lower part.
+if [ "${PROBE_SCROLL:-0}" -gt 0 ]; then
+  xdotool mousemove "$((left + w - 200))" 300
+  for _ in $(seq "$PROBE_SCROLL"); do xdotool click 5; sleep 0.05; done
+  sleep 0.5
+  xdotool mousemove 2 2
+  sleep 0.3
+fi
 import -window "$wid" "$root/$out"
 echo "wrote $out"
 send_key p
