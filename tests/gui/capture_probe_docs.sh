@@ -14,6 +14,7 @@
 #   PROBE_WAIT=8 PROBE_SCROLL=10 PROBE_SCENE=assets/scenes/door_ajar.json \
 #   PROBE_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" PROBE_OUT=docs/probe_guided.png \
 #   tests/gui/capture_probe_docs.sh "" 25 35 88
+# (probe_guided_partition.png at 50 8, probe_guided_wall.png at 75 45)
 # and docs/probe_light_choice.png (the README's starved box) is
 #   PROBE_WAIT=8 PROBE_SCENE=assets/scenes/starved_light.json PROBE_STRATEGY=nee-mis \
 #   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 10 30 88
