@@ -145,6 +145,16 @@ bool WeightLab::update(const Input& in) {
     reset(in.generation);
     changed = true;
   }
+  if (in.a == static_cast<int>(Technique::Guided) || in.b == static_cast<int>(Technique::Guided) ||
+      in.strategy.uses(Technique::Guided)) {
+    // No curve rather than the untrained sphere's.
+    if (curve_.active || curve_.why != kGuidedNotPredicted) changed = true;
+    curve_ = {};
+    curve_.why = kGuidedNotPredicted;
+    maps_ = {};
+    maps_.why = curve_.why;
+    return changed;
+  }
   TechniquePair pair;
   pair.a = std::string(technique_name(static_cast<Technique>(in.a)));
   pair.b = std::string(technique_name(static_cast<Technique>(in.b)));

@@ -96,6 +96,7 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
     }
     if (s.nee_mis || s.to_string().rfind("mix:", 0) == 0)
       throw InputError("--vary '" + vary + "': '" + *name + "' is not a mixture technique");
+    if (s.uses(Technique::Guided)) throw InputError("--vary '" + vary + "': " + kGuidedNotPredicted);
     *name = s.to_string();  // canonical, as the base mixture's terms are written
   }
   if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
@@ -104,6 +105,7 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
   if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
   s.roulette_depth = 0;  // the mixture's terms alone
   if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
+  if (s.uses(Technique::Guided)) throw InputError("--strategy '" + base + "': " + kGuidedNotPredicted);
   double pair = 0.0;
   for (const auto& [name, weight] : mixture_terms(s))
     if (name == f.a || name == f.b)

@@ -38,6 +38,13 @@ struct TechniquePair {
   double weight_of(const Strategy& s) const;
 };
 
+// Why a mixture with `guided` is not swept or predicted: the prediction
+// replays paths with each technique's density, and path guiding's density is
+// learned by the render's own training passes, which the replay cannot see.
+inline constexpr const char* kGuidedNotPredicted =
+    "guided's density is learned by each render's training passes, which the weight prediction cannot see: "
+    "a mixture with guided is not swept or predicted yet (docs/guiding.md)";
+
 // "A,B" (a comma between two technique names) with an optional base mixture
 // whose other techniques keep their weights, and Russian roulette from
 // `roulette_depth` on (0: the base's own, if any). InputError naming `vary` or `base`.
