@@ -2,6 +2,13 @@
 # Regenerates docs/viewer.png: the viewer on the book's scene under Xvfb,
 # captured after it has rendered for a while.
 #   tests/gui/capture_docs_screenshot.sh [PDFLAB] [SECONDS]
+# SHOT_SCENE, SHOT_STRATEGY and SHOT_OUT (a path under docs/) take another
+# scene, strategy and picture; SHOT_OPEN names a control to click first (a
+# panel section, as the layout names it). docs/guiding_viewer.png
+# (docs/guiding.md: the door scene with path guiding, the statistics section
+# open on the training's figures) is
+#   SHOT_SCENE=assets/scenes/door_ajar.json SHOT_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" \
+#   SHOT_OPEN=section.2 SHOT_OUT=docs/guiding_viewer.png tests/gui/capture_docs_screenshot.sh "" 15
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 inside_xvfb "1400x900x24" "xdotool import" "$0" "$@"
@@ -9,11 +16,15 @@ shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 # From the repository's root, so the panel's path field shows a path within it.
 cd "$root"
-pdflab=${1:-$root/build/release/app/pdflab}
+pdflab=${1:-}
+[ -n "$pdflab" ] || pdflab=$root/build/release/app/pdflab
 seconds=${2:-30}
-start_viewer "$pdflab" --scene assets/scenes/cornell_book.json --strategy "mix:cosine=0.5,light=0.5"
+out=${SHOT_OUT:-docs/viewer.png}
+start_viewer "$pdflab" --scene "${SHOT_SCENE:-assets/scenes/cornell_book.json}" \
+  --strategy "${SHOT_STRATEGY:-mix:cosine=0.5,light=0.5}"
+[ -z "${SHOT_OPEN:-}" ] || click "$SHOT_OPEN"
 sleep "$seconds"
-mkdir -p "$root/docs"
-import -window "$wid" "$root/docs/viewer.png"
+mkdir -p "$(dirname "$root/$out")"
+import -window "$wid" "$root/$out"
 quit_viewer
-echo "wrote $root/docs/viewer.png"
+echo "wrote $root/$out"
