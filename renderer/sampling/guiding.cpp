@@ -12,20 +12,24 @@ namespace pdflab {
 
 namespace {
 
-// Below 1 in double: a rescaled random number is kept below this.
-constexpr double kBelowOne = 1.0 - 0x1.0p-53;
 // A record's units at most: 2^24 of the brightest emission's, so 2^24 records
 // of that size still fit a slot.
 constexpr double kMostUnits = 0x1.0p40;
 
 const GuidingDistribution::QuadNode kUniformRoot{{1.0f, 1.0f, 1.0f, 1.0f}, {0, 0, 0, 0}, 0.5f, {0.5f, 0.5f}};
 
-// The quadrant of (s, t) in a node's square, and (s, t) in that quadrant's.
-int quadrant(double& s, double& t) {
-  const int x = s >= 0.5 ? 1 : 0, y = t >= 0.5 ? 1 : 0;
-  s = std::min(2.0 * s - x, kBelowOne);
-  t = std::min(2.0 * t - y, kBelowOne);
-  return x + 2 * y;
+// The energy recorded in a collecting node's four quadrants.
+double total_energy(const std::uint64_t (&energy)[4]) {
+  return static_cast<double>(energy[0]) + static_cast<double>(energy[1]) + static_cast<double>(energy[2]) +
+         static_cast<double>(energy[3]);
+}
+
+// The two halves of the box lo..hi split at `split` along `axis`: lo..below_hi and above_lo..hi.
+void halves(const Vec3& lo, const Vec3& hi, int axis, float split, Vec3& below_hi, Vec3& above_lo) {
+  below_hi = hi;
+  above_lo = lo;
+  below_hi[axis] = split;
+  above_lo[axis] = split;
 }
 
 }  // namespace
@@ -64,23 +68,6 @@ int GuidingDistribution::leaf_at(const Vec3& point, const Vec3& normal) const {
     i = static_cast<std::size_t>(n.child + (point[n.axis] >= n.split ? 1 : 0));
   }
   return spatial_[i].leaf;
-}
-
-void GuidingDistribution::leaf_box(int leaf, Vec3& lo, Vec3& hi) const {
-  const std::function<bool(std::size_t, Vec3, Vec3)> walk = [&](std::size_t i, Vec3 a, Vec3 b) {
-    const SpatialNode& n = spatial_[i];
-    if (n.axis < 0) {
-      if (n.leaf != leaf) return false;
-      lo = a, hi = b;
-      return true;
-    }
-    Vec3 mid_hi = b, mid_lo = a;
-    mid_hi[n.axis] = n.split;
-    mid_lo[n.axis] = n.split;
-    return walk(static_cast<std::size_t>(n.child), a, mid_hi) || walk(static_cast<std::size_t>(n.child + 1), mid_lo, b);
-  };
-  for (std::size_t k = 0; k < static_cast<std::size_t>(kGuidingNormalBins); ++k)
-    if (walk(k, lo_, hi_)) return;
 }
 
 GuidingDistribution::Sample GuidingDistribution::sample(const Vec3& point, const Vec3& normal, float u1,
@@ -170,23 +157,14 @@ GuidingTrainer::GuidingTrainer(const Scene& scene)
     : GuidingTrainer(scene_box(scene, false), scene_box(scene, true), 0x1.0p24 / brightest_emission(scene)) {}
 
 GuidingTrainer::GuidingTrainer(const Vec3& lo, const Vec3& hi, double scale)
-    : scale_(scale), leaves_(kGuidingNormalBins) {
-  for (int k = 0; k < kGuidingNormalBins; ++k) {
-    spatial_.push_back({-1, 0.0f, 0, k});
-    leaves_[static_cast<std::size_t>(k)].nodes.push_back(CollectNode{{0, 0, 0, 0}, {0, 0, 0, 0}});
-  }
-  current_ = std::make_shared<GuidingDistribution>(lo, hi);
+    : scale_(scale), leaves_(kGuidingNormalBins), current_(std::make_shared<GuidingDistribution>(lo, hi)) {
+  for (Leaf& leaf : leaves_) leaf.nodes.push_back(CollectNode{{0, 0, 0, 0}, {0, 0, 0, 0}});
 }
 
 GuidingTrainer::~GuidingTrainer() = default;
 
 void GuidingTrainer::record(const Vec3& point, const Vec3& normal, const Vec3& direction, double energy) {
-  auto i = static_cast<std::size_t>(guiding_normal_bin(normal));
-  while (spatial_[i].axis >= 0) {
-    const GuidingDistribution::SpatialNode& n = spatial_[i];
-    i = static_cast<std::size_t>(n.child + (point[n.axis] >= n.split ? 1 : 0));
-  }
-  Leaf& leaf = leaves_[static_cast<std::size_t>(spatial_[i].leaf)];
+  Leaf& leaf = leaves_[static_cast<std::size_t>(current_->leaf_at(point, normal))];
   std::atomic_ref<std::uint64_t>(leaf.count).fetch_add(1, std::memory_order_relaxed);
   if (!(energy > 0.0)) return;  // no light (or not a number): counted, nothing added
   const double units = std::min(std::floor(energy * scale_ + 0.5), kMostUnits);
@@ -194,11 +172,11 @@ void GuidingTrainer::record(const Vec3& point, const Vec3& normal, const Vec3& d
 }
 
 void GuidingTrainer::collect(Leaf& leaf, const SquarePoint& p, std::uint64_t units) {
-  double s = p.s, t = p.t;
+  float s = p.s, t = p.t;
   std::int32_t node = 0;
   for (;;) {
     CollectNode& n = leaf.nodes[static_cast<std::size_t>(node)];
-    const int c = quadrant(s, t);
+    const int c = leaf::guide_quadrant(s, t);
     if (n.child[c] == 0) {
       std::atomic_ref<std::uint64_t>(n.energy[c]).fetch_add(units, std::memory_order_relaxed);
       return;
@@ -210,15 +188,13 @@ void GuidingTrainer::collect(Leaf& leaf, const SquarePoint& p, std::uint64_t uni
 void GuidingTrainer::finish_pass() {
   // 1. Each quadrant's energy: its own where it is a leaf cell, its subtree's otherwise.
   for (Leaf& leaf : leaves_) {
+    // (The nodes are only written, never added: references into them hold.)
     const std::function<std::uint64_t(std::int32_t)> total = [&](std::int32_t node) {
+      CollectNode& n = leaf.nodes[static_cast<std::size_t>(node)];
       std::uint64_t sum = 0;
       for (int c = 0; c < 4; ++c) {
-        CollectNode& n = leaf.nodes[static_cast<std::size_t>(node)];
-        if (n.child[c]) {
-          const std::uint64_t below = total(n.child[c]);
-          leaf.nodes[static_cast<std::size_t>(node)].energy[c] = below;
-        }
-        sum += leaf.nodes[static_cast<std::size_t>(node)].energy[c];
+        if (n.child[c]) n.energy[c] = total(n.child[c]);
+        sum += n.energy[c];
       }
       return sum;
     };
@@ -240,9 +216,8 @@ void GuidingTrainer::finish_pass() {
             const auto child = static_cast<std::int32_t>(spatial.size());
             spatial[at] = {axis, split, child, -1};
             spatial.resize(spatial.size() + 2);
-            Vec3 mid_hi = hi, mid_lo = lo;
-            mid_hi[axis] = split;
-            mid_lo[axis] = split;
+            Vec3 mid_hi, mid_lo;
+            halves(lo, hi, axis, split, mid_hi, mid_lo);
             place(static_cast<std::size_t>(child), leaf, count / 2, lo, mid_hi, depth + 1);
             place(static_cast<std::size_t>(child) + 1, leaf, count - count / 2, mid_lo, hi, depth + 1);
             return;
@@ -254,7 +229,7 @@ void GuidingTrainer::finish_pass() {
       };
   const std::function<void(std::size_t, std::size_t, Vec3, Vec3, int)> rebuild = [&](std::size_t old, std::size_t at,
                                                                                       Vec3 lo, Vec3 hi, int depth) {
-    const GuidingDistribution::SpatialNode& n = spatial_[old];
+    const GuidingDistribution::SpatialNode& n = current_->spatial_[old];
     if (n.axis < 0) {
       const Leaf& leaf = leaves_[static_cast<std::size_t>(n.leaf)];
       place(at, leaf, leaf.count, lo, hi, depth);
@@ -263,9 +238,8 @@ void GuidingTrainer::finish_pass() {
     const auto child = static_cast<std::int32_t>(spatial.size());
     spatial[at] = {n.axis, n.split, child, -1};
     spatial.resize(spatial.size() + 2);
-    Vec3 mid_hi = hi, mid_lo = lo;
-    mid_hi[n.axis] = n.split;
-    mid_lo[n.axis] = n.split;
+    Vec3 mid_hi, mid_lo;
+    halves(lo, hi, n.axis, n.split, mid_hi, mid_lo);
     rebuild(static_cast<std::size_t>(n.child), static_cast<std::size_t>(child), lo, mid_hi, depth + 1);
     rebuild(static_cast<std::size_t>(n.child) + 1, static_cast<std::size_t>(child) + 1, mid_lo, hi, depth + 1);
   };
@@ -281,14 +255,12 @@ void GuidingTrainer::finish_pass() {
     const std::vector<CollectNode>& nodes = leaves[k].nodes;
     const auto first = static_cast<std::int32_t>(next->nodes_.size());
     next->roots_[k] = first;
-    const CollectNode& root = nodes[0];
-    if (root.energy[0] + root.energy[1] + root.energy[2] + root.energy[3] == 0) {
+    if (total_energy(nodes[0].energy) == 0.0) {
       next->nodes_.push_back(kUniformRoot);
       continue;
     }
     for (const CollectNode& n : nodes) {
-      const double sum = static_cast<double>(n.energy[0]) + static_cast<double>(n.energy[1]) +
-                         static_cast<double>(n.energy[2]) + static_cast<double>(n.energy[3]);
+      const double sum = total_energy(n.energy);
       GuidingDistribution::QuadNode q{};
       for (int c = 0; c < 4; ++c) {
         q.factor[c] = sum > 0.0 ? static_cast<float>(4.0 * static_cast<double>(n.energy[c]) / sum) : 1.0f;
@@ -300,15 +272,14 @@ void GuidingTrainer::finish_pass() {
   }
   for (GuidingDistribution::SpatialNode& n : spatial)
     if (n.axis < 0) n.child = next->roots_[static_cast<std::size_t>(n.leaf)];
-  next->spatial_ = spatial;
+  next->spatial_ = std::move(spatial);
 
   // 4. The D-trees the next pass records into: cells above kGuidingSplitShare
   // of their leaf's energy split (where a cell was a leaf, its energy is
   // taken as spread evenly over its quadrants), the rest merged; energies reset.
   for (Leaf& leaf : leaves) {
     const CollectNode& root = leaf.nodes[0];
-    const double leaf_total = static_cast<double>(root.energy[0]) + static_cast<double>(root.energy[1]) +
-                              static_cast<double>(root.energy[2]) + static_cast<double>(root.energy[3]);
+    const double leaf_total = total_energy(root.energy);
     std::vector<CollectNode> refined;
     // A node for a square holding `energy[c]` in its quadrants (`old`: its node
     // in the old tree, -1: none, the energy spread evenly), at `depth`.
@@ -340,7 +311,6 @@ void GuidingTrainer::finish_pass() {
     leaf.count = 0;
   }
 
-  spatial_ = std::move(spatial);
   leaves_ = std::move(leaves);
   current_ = std::move(next);
   ++passes_;

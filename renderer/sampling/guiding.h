@@ -117,7 +117,6 @@ class GuidingDistribution {
   // Leaf `leaf`'s D-tree: its root, and any node of it.
   std::int32_t root(int leaf) const { return roots_[static_cast<std::size_t>(leaf)]; }
   const QuadNode& node(std::int32_t i) const { return nodes_[static_cast<std::size_t>(i)]; }
-  void leaf_box(int leaf, Vec3& lo, Vec3& hi) const;
   // Points on the edges between the cells of `point`'s D-tree, `per_edge` on
   // each inner edge of each node, as unit directions: where the density may
   // jump (for the chi-square harness).
@@ -165,7 +164,7 @@ class GuidingTrainer {
     std::uint64_t energy[4];
     std::int32_t child[4];
   };
-  struct Leaf {
+  struct Leaf {  // of current_'s S-tree, by its leaf number
     std::vector<CollectNode> nodes;
     std::uint64_t count = 0;
   };
@@ -174,7 +173,6 @@ class GuidingTrainer {
   double scale_ = 1.0;
   int passes_ = 0;
   std::uint64_t records_total_ = 0;
-  std::vector<GuidingDistribution::SpatialNode> spatial_;  // the S-tree, as current_'s (leaf: `leaf` is the Leaf)
   std::vector<Leaf> leaves_;
   std::shared_ptr<const GuidingDistribution> current_;
 };
