@@ -220,17 +220,13 @@ void RenderSession::finish_pass_locked() {
   if (pass_.preview) {
     spare_rgb_.assign(preview_.begin(), preview_.end());
     publish_locked(spare_rgb_, pass_);
-    if (paused_) {
-      seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
-      running_clock_ = false;
-    } else {
-      start_pass_locked();
-    }
+    if (paused_) stop_clock_locked(now);
+    else start_pass_locked();
     done_cv_.notify_all();
     return;
   }
   if (pass_.training) {
-    finish_training_locked();
+    finish_training_locked(now);
     done_cv_.notify_all();
     return;
   }
@@ -245,38 +241,20 @@ void RenderSession::finish_pass_locked() {
   // against passes of 30-120 ms while every other worker waited (the book
   // mixture on two threads: 3.5% more samples a second without that wait;
   // the more threads, the more they waited).
-  if (pass_.sweep) {
-    NoiseSums sums;
-    for (const NoiseSums& tile : tile_noise_) sums.add(tile);
-    noise_ = sums.summary();
-    next_sweep_spp_ = spp_done_ + std::max<std::uint32_t>(1, spp_done_ / kSweepGrowth);
-  }
-  if (options_.publish_images) {
-    spare_drops_ = film_.drop_masks();
-    publish_locked(spare_rgb_, pass_);
-  }
+  publish_pass_locked();
+  if (pass_.sweep) next_sweep_spp_ = spp_done_ + std::max<std::uint32_t>(1, spp_done_ / kSweepGrowth);
 
   // Aim for passes of 30-120 ms: short enough to react, long enough to amortise.
   if (pass_ms < 30.0 && next_pass_spp_ < 256) next_pass_spp_ *= 2;
   if (pass_ms > 120.0 && next_pass_spp_ > 1) next_pass_spp_ /= 2;
 
   const bool done = target_reached_locked(seconds_before_ + std::chrono::duration<double>(now - resumed_at_).count());
-  if (done || paused_) {
-    seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
-    running_clock_ = false;
-  } else {
-    start_pass_locked();
-  }
+  if (done || paused_) stop_clock_locked(now);
+  else start_pass_locked();
   done_cv_.notify_all();
 }
 
-void RenderSession::finish_training_locked() {
-  // What the pass recorded becomes the next distribution, which the next
-  // pass (or the render) samples with; the pass's image is shown, then cleared.
-  trainer_->finish_pass();
-  guide_ = trainer_->distribution();
-  plan_.guiding = guide_.get();
-  ++training_done_;
+void RenderSession::publish_pass_locked() {
   if (pass_.sweep) {
     NoiseSums sums;
     for (const NoiseSums& tile : tile_noise_) sums.add(tile);
@@ -286,15 +264,26 @@ void RenderSession::finish_training_locked() {
     spare_drops_ = film_.drop_masks();
     publish_locked(spare_rgb_, pass_);
   }
+}
+
+void RenderSession::stop_clock_locked(std::chrono::steady_clock::time_point now) {
+  seconds_before_ += std::chrono::duration<double>(now - resumed_at_).count();
+  running_clock_ = false;
+}
+
+void RenderSession::finish_training_locked(std::chrono::steady_clock::time_point now) {
+  // What the pass recorded becomes the next distribution, which the next
+  // pass (or the render) samples with; the pass's image is shown, then cleared.
+  trainer_->finish_pass();
+  guide_ = trainer_->distribution();
+  plan_.guiding = guide_.get();
+  ++training_done_;
+  publish_pass_locked();
   film_.clear();
   drops_ = DropCounts{};
   noise_ = NoiseSummary{};
-  if (paused_) {
-    seconds_before_ += std::chrono::duration<double>(Clock::now() - resumed_at_).count();
-    running_clock_ = false;
-  } else {
-    start_pass_locked();
-  }
+  if (paused_) stop_clock_locked(now);
+  else start_pass_locked();
 }
 
 void RenderSession::publish_locked(std::vector<float>& rgb, const Pass& pass) {

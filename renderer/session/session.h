@@ -205,7 +205,13 @@ class RenderSession {
   void publish_film_locked();  // the whole film as a complete pass of this generation
   int preview_scale_locked() const;
   void finish_pass_locked();
-  void finish_training_locked();  // a training pass ends (finish_pass_locked)
+  // A training pass ends (finish_pass_locked, at `now`).
+  void finish_training_locked(std::chrono::steady_clock::time_point now);
+  // The ended pass's noise figures (its tiles' sweeps, where it has them)
+  // and, for a viewer, its image.
+  void publish_pass_locked();
+  // The clock stops at `now` (paused, or the render done).
+  void stop_clock_locked(std::chrono::steady_clock::time_point now);
   void change_settings(RenderSettings settings, std::optional<FilmStart> start);
   void apply_settings_locked(RenderSettings settings, const SamplingPlan& plan, std::optional<FilmStart> start);
   void wait_idle_locked(std::unique_lock<std::mutex>& lk, const char* caller) const;
