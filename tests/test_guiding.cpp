@@ -5,6 +5,7 @@
 // count, and the guided mixtures' images against cosine's.
 #include "renderer/integrator/packet.h"
 #include "renderer/metrics/chi_square.h"
+#include "renderer/metrics/probe.h"
 #include "renderer/metrics/statistics.h"
 #include "renderer/sampling/guiding.h"
 #include "renderer/scene/scene_loader.h"
@@ -127,6 +128,43 @@ TEST(GuidingTrainer, LearnsWhereTheLightComesFrom) {
   EXPECT_EQ(trainer.passes(), 3);
 }
 
+// The probe's picture of a leaf's quadtree: its cells tile the map, each
+// carries the density the distribution gives its directions, and together
+// they integrate to one; a leaf's box holds the points that find it.
+TEST(GuidingDistribution, CellsAndBoxesDescribeTheTrees) {
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
+  const Vec3 towards = normalize(Vec3(-0.4f, 0.2f, 0.9f));
+  for (int pass = 0; pass < 2; ++pass) teach(trainer, towards, 10.0, 300.0, 300000, 40 + static_cast<std::uint64_t>(pass));
+  const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+  const Vec3 up(0.0f, 0.0f, 1.0f);
+  ASSERT_GT(g->leaves(), kGuidingNormalBins);
+  Rng rng(5, 5);
+  for (int i = 0; i < 20; ++i) {
+    const Vec3 at(rng.uniform(), rng.uniform(), rng.uniform());
+    const std::vector<GuidingDistribution::Cell> cells = g->cells(g->leaf_at(at, up));
+    ASSERT_GT(cells.size(), 4u);
+    double area = 0.0, mass = 0.0;
+    for (const GuidingDistribution::Cell& c : cells) {
+      area += static_cast<double>(c.size) * c.size;
+      mass += static_cast<double>(c.pdf) * c.size * c.size * 4.0 * kPi;
+      const Vec3 d = direction_from_square(c.s + 0.5f * c.size, c.t + 0.5f * c.size);
+      EXPECT_NEAR(g->pdf(at, up, d), c.pdf, 1e-5 * c.pdf);
+    }
+    EXPECT_NEAR(area, 1.0, 1e-9);
+    EXPECT_NEAR(mass, 1.0, 1e-5);
+    Vec3 lo, hi;
+    g->leaf_box(at, up, lo, hi);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(lo[a], at[a]);
+      EXPECT_GT(hi[a], at[a]);
+      EXPECT_LT(hi[a] - lo[a], 1.0001f);
+    }
+    // The box's middle and a point just inside its far corner find the same leaf.
+    EXPECT_EQ(g->leaf_at((lo + hi) * 0.5f, up), g->leaf_at(at, up));
+    EXPECT_EQ(g->leaf_at(lo + (hi - lo) * 0.999f, up), g->leaf_at(at, up));
+  }
+}
+
 TEST(GuidingTrainer, TheSameTreesForAnyOrderOfRecords) {
   // Records added in two orders (as threads would) give the same distribution, bit for bit, pass after pass.
   const Vec3 towards(0.0f, 0.0f, 1.0f);
@@ -202,6 +240,47 @@ std::shared_ptr<const Scene> small_door(int width, int height) {
   s->camera.height = height;
   s->prepare();
   return s;
+}
+
+// The spatial tree's overlay: each pixel's leaf holds the surface point the
+// pixel sees, and a floor and a wall never share a leaf (one tree per way a
+// surface faces).
+TEST(GuidingDistribution, LeafMapFollowsTheSurfaces) {
+  const auto scene = small_door(48, 36);
+  GuidingTrainer trainer(*scene);
+  const Vec3 lo = trainer.distribution()->lo(), hi = trainer.distribution()->hi();
+  Rng rng(3, 3);
+  const Vec3 faces[] = {Vec3(0.0f, 1.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f),
+                        Vec3(-1.0f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 1.0f), Vec3(0.0f, 0.0f, -1.0f)};
+  for (int i = 0; i < 400000; ++i) {
+    const Vec3 p = lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    const Vec3 d = direction_from_square(rng.uniform(), rng.uniform());
+    trainer.record(p, faces[i % 6], d, 1.0);
+  }
+  trainer.finish_pass();
+  const GuidingDistribution& g = *trainer.distribution();
+  const std::vector<std::int32_t> leaves = guiding_leaf_map(*scene, g);
+  ASSERT_EQ(leaves.size(), 48u * 36u);
+  std::vector<int> bin_of_leaf(static_cast<std::size_t>(g.leaves()), -1);
+  int distinct = 0;
+  for (int y = 0; y < 36; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const std::int32_t leaf = leaves[static_cast<std::size_t>(y * 48 + x)];
+      const ProbePoint at = first_diffuse_hit(*scene, x, y);
+      ASSERT_EQ(leaf >= 0, at.found) << x << ", " << y;
+      if (!at.found) continue;
+      Vec3 box_lo, box_hi;
+      g.leaf_box(at.point, at.normal, box_lo, box_hi);
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(box_lo[a], at.point[a]);
+        EXPECT_GE(box_hi[a], at.point[a]);
+      }
+      int& bin = bin_of_leaf[static_cast<std::size_t>(leaf)];
+      if (bin < 0) ++distinct;
+      else EXPECT_EQ(bin, guiding_normal_bin(at.normal)) << "leaf " << leaf << " holds two ways of facing";
+      bin = guiding_normal_bin(at.normal);
+    }
+  EXPECT_GT(distinct, 6);
 }
 
 // The training passes record through the packet tracer from every worker at

@@ -3,6 +3,7 @@
 #include "renderer/error.h"
 #include "renderer/integrator/integrator.h"
 #include "renderer/metrics/chi_square.h"
+#include "renderer/sampling/guiding.h"
 
 #include "renderer/sampling/onb.h"
 
@@ -166,6 +167,19 @@ std::vector<float> pdf_map(const SamplingPlan& plan, const ProbePoint& at, int w
 std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int width, int height, int supersample) {
   const SamplingPlan plan = SamplingPlan::make(Strategy::single(Technique::Bsdf), scene);
   return map_of(at, width, height, supersample, [&](const Vec3& d) { return plan.pdf(at.surface, at.point, at.normal, d); });
+}
+
+std::vector<std::int32_t> guiding_leaf_map(const Scene& scene, const GuidingDistribution& guide) {
+  const int width = scene.camera.width, height = scene.camera.height;
+  std::vector<std::int32_t> leaves(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const ProbePoint at = first_diffuse_hit(scene, x, y);
+      if (at.found)
+        leaves[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] =
+            guide.leaf_at(at.point, at.normal);
+    }
+  return leaves;
 }
 
 std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, int width, int height, int per_cell,

@@ -65,6 +65,11 @@ std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int wi
 // All zeros where no light arrives. Deterministic for a seed.
 std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, int width, int height, int per_cell,
                                       std::uint64_t seed);
+// Path guiding's spatial tree as the camera sees it: per pixel of the
+// camera's image (row 0 at the top), the S-tree leaf that `guide` gives the
+// first diffuse surface the pixel's ray meets (as first_diffuse_hit finds
+// it, with the normal facing the ray), -1 where there is none.
+std::vector<std::int32_t> guiding_leaf_map(const Scene& scene, const GuidingDistribution& guide);
 // The bsdf technique's pdf at the probe point for one direction.
 float bsdf_pdf(const Scene& scene, const ProbePoint& at, const Vec3& direction);
 // In words, what that lobe is at the probe point ("cosine lobe (lambertian)",

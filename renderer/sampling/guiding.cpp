@@ -101,6 +101,38 @@ std::vector<Vec3> GuidingDistribution::density_edges(const Vec3& point, const Ve
   return out;
 }
 
+std::vector<GuidingDistribution::Cell> GuidingDistribution::cells(int leaf) const {
+  std::vector<Cell> out;
+  const std::function<void(std::int32_t, float, float, float, double)> walk = [&](std::int32_t at, float s, float t,
+                                                                                float size, double density) {
+    const QuadNode& n = node(at);
+    const float half = 0.5f * size;
+    for (int c = 0; c < 4; ++c) {
+      const float cs = s + static_cast<float>(c & 1) * half, ct = t + static_cast<float>(c >> 1) * half;
+      const double d = density * n.factor[c];
+      if (n.child[c]) walk(n.child[c], cs, ct, half, d);
+      else out.push_back({cs, ct, half, static_cast<float>(d / (4.0 * kPi))});
+    }
+  };
+  walk(root(leaf), 0.0f, 0.0f, 1.0f, 1.0);
+  return out;
+}
+
+void GuidingDistribution::leaf_box(const Vec3& point, const Vec3& normal, Vec3& lo, Vec3& hi) const {
+  lo = lo_;
+  hi = hi_;
+  auto i = static_cast<std::size_t>(guiding_normal_bin(normal));
+  while (spatial_[i].axis >= 0) {
+    const SpatialNode& n = spatial_[i];
+    Vec3 below_hi, above_lo;
+    halves(lo, hi, n.axis, n.split, below_hi, above_lo);
+    const bool above = point[n.axis] >= n.split;
+    if (above) lo = above_lo;
+    else hi = below_hi;
+    i = static_cast<std::size_t>(n.child + (above ? 1 : 0));
+  }
+}
+
 GuidingDistribution::Stats GuidingDistribution::stats() const {
   Stats s;
   s.leaves = leaves();

@@ -117,6 +117,17 @@ class GuidingDistribution {
   // Leaf `leaf`'s D-tree: its root, and any node of it.
   std::int32_t root(int leaf) const { return roots_[static_cast<std::size_t>(leaf)]; }
   const QuadNode& node(std::int32_t i) const { return nodes_[static_cast<std::size_t>(i)]; }
+  // One leaf cell of a D-tree: its square [s, s + size) x [t, t + size) in
+  // the map, and the density there per steradian.
+  struct Cell {
+    float s, t, size;
+    float pdf;
+  };
+  // Leaf `leaf`'s D-tree as its cells (the 2D picture of the quadtree; the
+  // cells tile the unit square, so sum(pdf x size^2) x 4 pi = 1).
+  std::vector<Cell> cells(int leaf) const;
+  // The box of the S-tree leaf holding `point` (in the tree of `normal`'s bin).
+  void leaf_box(const Vec3& point, const Vec3& normal, Vec3& lo, Vec3& hi) const;
   // Points on the edges between the cells of `point`'s D-tree, `per_edge` on
   // each inner edge of each node, as unit directions: where the density may
   // jump (for the chi-square harness).
