@@ -109,7 +109,8 @@ void add_viewer_options(CLI::App& app, ViewerCommand& v) {
   app.add_flag("--auto-weight", v.auto_weight,
                "Start with auto weight: a two-technique mixture's w moves between passes to the predicted best");
   app.add_option("--view", v.mode,
-                 "Start in a view mode: image, heatmap, difference, drops, best-weight, technique-share");
+                 "Start in a view mode: image, heatmap, difference, drops, best-weight, technique-share, "
+                 "guiding-tree");
   app.add_option("--reference", v.reference,
                  "Reference (a .pfm, .exr or .film) for live error figures in the viewer (default: the cached one, "
                  "if any)");

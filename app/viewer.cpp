@@ -9,6 +9,7 @@
 #include "renderer/scene/scene_loader.h"
 #include "renderer/film/film_file.h"
 #include "renderer/hash.h"
+#include "renderer/metrics/probe.h"
 #include "renderer/session/session.h"
 #include "ui/camera_control.h"
 #include "ui/display.h"
@@ -262,6 +263,11 @@ struct Viewer::Impl {
   void handle_measure_requests(const ui::MeasureRequests& r);
   void service_weights();
   void service_auto_weight();
+  void service_guiding_tree();
+  // What the guiding-tree view's map was made from.
+  std::shared_ptr<const GuidingDistribution> leaf_map_guide;
+  std::shared_ptr<const Scene> leaf_map_scene;
+  bool leaf_map_made = false;
 
   // The steps of a frame, in order (see Viewer::frame).
   struct FrameLayout;
@@ -1070,7 +1076,8 @@ void Viewer::Impl::fill_status() {
   status.max_depth = applied.max_depth;
   status.messages = messages();
   const ui::ViewMode mode = settings.measure.view_mode;
-  status.can_export_view = mode != ui::ViewMode::Image && mode != ui::ViewMode::Drops && measure.layer_ok &&
+  status.can_export_view = mode != ui::ViewMode::Image && mode != ui::ViewMode::Drops &&
+                           mode != ui::ViewMode::GuidingTree && measure.layer_ok &&
                            measure.layer_mode == mode && !teaching->split_active();
   status.can_export_curve = !status.weights.weight.empty() && status.weights.active;
   status.can_export_convergence = !measure.curves.live().points.empty() || !measure.curves.pins().empty();
@@ -1147,7 +1154,8 @@ std::string saved_text(const std::string& what, const std::vector<std::string>& 
 // (what is shown, of which render, measured how).
 void Viewer::Impl::export_view() {
   const ui::ViewMode mode = settings.measure.view_mode;
-  if (mode == ui::ViewMode::Image || mode == ui::ViewMode::Drops || !measure.layer_ok || measure.layer_mode != mode) {
+  if (mode == ui::ViewMode::Image || mode == ui::ViewMode::Drops || mode == ui::ViewMode::GuidingTree ||
+      !measure.layer_ok || measure.layer_mode != mode) {
     notice("Nothing to export: V picks a heat map, difference, best-weight or technique-share view to export.", true);
     return;
   }
@@ -1277,6 +1285,33 @@ void Viewer::Impl::service_weights() {
   }
 }
 
+// The guiding-tree view: while it is on, its map follows the session's
+// distribution (a new one at the end of each training pass).
+void Viewer::Impl::service_guiding_tree() {
+  if (settings.measure.view_mode != ui::ViewMode::GuidingTree) return;
+  std::shared_ptr<const GuidingDistribution> guide = session->guiding();
+  if (leaf_map_made && guide == leaf_map_guide && render_scene == leaf_map_scene) return;
+  const int pass = session->stats().guiding_pass;  // read after the distribution: it cannot be older
+  leaf_map_made = true;
+  leaf_map_guide = guide;
+  leaf_map_scene = render_scene;
+  ui::GuidingLeafMap map;
+  if (!guide) {
+    map.why = "render a strategy with guided (its training builds the tree), e.g. nee-mis+mix:cosine=0.5,guided=0.5";
+  } else {
+    map.width = render_scene->camera.width;
+    map.height = render_scene->camera.height;
+    map.leaf = guiding_leaf_map(*render_scene, *guide);
+    map.leaves = guide->leaves();
+    map.pass = pass;
+    std::vector<char> seen(static_cast<std::size_t>(map.leaves), 0);
+    for (const std::int32_t l : map.leaf)
+      if (l >= 0 && !std::exchange(seen[static_cast<std::size_t>(l)], 1)) ++map.on_screen;
+  }
+  measure.set_guiding_leaves(std::move(map));
+  settle_frames = std::max(settle_frames, 1);
+}
+
 // Auto weight: at 16, 32, 64, ... spp the weight moves to the best that the
 // passes so far predict, and the accumulation goes on (the film continues,
 // with the next sample indices). Each pass's weight is fixed before the pass
@@ -1365,6 +1400,7 @@ void Viewer::Impl::service_background() {
   teaching->set_shared_reference(measure.matching_reference());
   service_auto_weight();
   service_weights();
+  service_guiding_tree();
   service_references();
   teaching->update(*session, settings.paused);
   service_screenshots();

@@ -56,6 +56,23 @@ Colour diverging_colour(double t) {
   return lerp_stops(kStops, 5, (std::clamp(std::isfinite(t) ? t : 0.0, -1.0, 1.0) + 1.0) * 0.5);
 }
 
+Colour guiding_leaf_colour(int leaf) {
+  // Hues a golden angle apart, at two lightnesses by turns.
+  const double hue = std::fmod(static_cast<double>(leaf) * 0.6180339887498949, 1.0) * 6.0;
+  const double f = hue - std::floor(hue), lightness = leaf % 2 ? 0.75 : 1.0;
+  const double q = 1.0 - f;
+  double r = 0.0, g = 0.0, b = 0.0;
+  switch (static_cast<int>(hue)) {
+    case 0: r = 1.0, g = f, b = 0.0; break;
+    case 1: r = q, g = 1.0, b = 0.0; break;
+    case 2: r = 0.0, g = 1.0, b = f; break;
+    case 3: r = 0.0, g = q, b = 1.0; break;
+    case 4: r = f, g = 0.0, b = 1.0; break;
+    default: r = 1.0, g = 0.0, b = q; break;
+  }
+  return {static_cast<float>(r * lightness), static_cast<float>(g * lightness), static_cast<float>(b * lightness)};
+}
+
 Colour drop_reason_colour(int reason) {
   switch (static_cast<DropReason>(reason)) {
     case DropReason::PdfZero: return {1.0f, 0.25f, 0.85f};            // magenta

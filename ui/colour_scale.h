@@ -25,6 +25,9 @@ Colour diverging_colour(double t);  // t in -1..1
 // One colour per DropReason, and one for a pixel with several reasons.
 Colour drop_reason_colour(int reason);
 inline constexpr Colour kSeveralDropReasonsColour = {1.0f, 1.0f, 1.0f};
+// A path guiding leaf's colour (the guiding-tree view, the probe's swatch):
+// hues a golden angle apart, so neighbouring numbers differ.
+Colour guiding_leaf_colour(int leaf);
 
 // The value scale of a false-colour view and its legend.
 struct ColourScale {

@@ -22,18 +22,19 @@ const char* view_mode_label(ViewMode mode) {
     case ViewMode::Drops: return "dropped samples";
     case ViewMode::BestWeight: return "best weight (predicted)";
     case ViewMode::TechniqueShare: return "which technique found the light";
+    case ViewMode::GuidingTree: return "path guiding's spatial tree";
     case ViewMode::Count: break;
   }
   return "?";
 }
 
 ViewMode parse_view_mode(const std::string& name) {
-  static constexpr const char* kNames[kViewModeCount] = {"image",       "heatmap",    "difference",
-                                                        "drops",       "best-weight", "technique-share"};
+  static constexpr const char* kNames[kViewModeCount] = {"image",       "heatmap",         "difference",  "drops",
+                                                        "best-weight", "technique-share", "guiding-tree"};
   for (int i = 0; i < kViewModeCount; ++i)
     if (name == kNames[i]) return static_cast<ViewMode>(i);
   throw InputError("--view '" + name +
-                   "' is not a view mode (image, heatmap, difference, drops, best-weight, technique-share)");
+                   "' is not a view mode (image, heatmap, difference, drops, best-weight, technique-share, guiding-tree)");
 }
 
 ViewMode next_view_mode(ViewMode mode) {
@@ -280,11 +281,40 @@ bool build_weight_layer(ViewMode mode, const WeightMaps* maps, ViewLayer& out, s
   return true;
 }
 
+// Path guiding's S-tree over the image: each leaf a translucent colour, the
+// borders between leaves (and around what no leaf holds) drawn solid.
+bool build_guiding_layer(const GuidingLeafMap* map, ViewLayer& out, std::string& why) {
+  const std::size_t pixels = map ? static_cast<std::size_t>(map->width) * static_cast<std::size_t>(map->height) : 0;
+  if (!map || pixels == 0 || map->leaf.size() != pixels) {
+    why = map && !map->why.empty() ? map->why : "render a strategy with guided (its training builds the tree)";
+    return false;
+  }
+  out.width = map->width;
+  out.height = map->height;
+  out.rgba.assign(4 * pixels, 0);
+  out.drop_pixels = {};
+  const auto at = [&](int x, int y) {
+    return map->leaf[static_cast<std::size_t>(y) * static_cast<std::size_t>(map->width) + static_cast<std::size_t>(x)];
+  };
+  for (int y = 0; y < map->height; ++y)
+    for (int x = 0; x < map->width; ++x) {
+      const std::int32_t leaf = at(x, y);
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(map->width) + static_cast<std::size_t>(x);
+      if (leaf < 0) continue;  // transparent: the image shows
+      const bool border = (x + 1 < map->width && at(x + 1, y) != leaf) || (y + 1 < map->height && at(x, y + 1) != leaf);
+      if (border) put(out.rgba, p, {0.05f, 0.05f, 0.05f}, 230);
+      else put(out.rgba, p, guiding_leaf_colour(leaf), 110);
+    }
+  return true;
+}
+
 }  // namespace
 
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
-                      std::string& why, const LayerOptions* given, const WeightMaps* maps) {
+                      std::string& why, const LayerOptions* given, const WeightMaps* maps,
+                      const GuidingLeafMap* leaves) {
   if (mode == ViewMode::BestWeight || mode == ViewMode::TechniqueShare) return build_weight_layer(mode, maps, out, why);
+  if (mode == ViewMode::GuidingTree) return build_guiding_layer(leaves, out, why);
   const LayerOptions options = given ? *given
                                      : (mode == ViewMode::Difference ? default_difference_options()
                                                                      : default_heat_map_options());

@@ -12,12 +12,21 @@
 
 namespace pdflab::ui {
 
-enum class ViewMode : std::uint8_t { Image, RelativeError, Difference, Drops, BestWeight, TechniqueShare, Count };
+enum class ViewMode : std::uint8_t {
+  Image,
+  RelativeError,
+  Difference,
+  Drops,
+  BestWeight,
+  TechniqueShare,
+  GuidingTree,
+  Count
+};
 inline constexpr int kViewModeCount = static_cast<int>(ViewMode::Count);
 const char* view_mode_label(ViewMode mode);
 ViewMode next_view_mode(ViewMode mode);
 // A view mode by its short name (image, heatmap, difference, drops,
-// best-weight, technique-share); InputError naming them otherwise.
+// best-weight, technique-share, guiding-tree); InputError naming them otherwise.
 ViewMode parse_view_mode(const std::string& name);
 
 // The per-pixel error a false-colour view shows, chosen as in tev: the signed
@@ -99,8 +108,20 @@ ColourScale best_weight_scale(const WeightMaps& maps);
 // The technique-share view's: sequential, 0 (all found by b) to 1 (all by a).
 ColourScale technique_share_scale(const WeightMaps& maps);
 
+// The guiding-tree view's data (the viewer makes it from the session's
+// distribution): per pixel the S-tree leaf of the surface it sees
+// (guiding_leaf_map; -1: none).
+struct GuidingLeafMap {
+  std::string why;  // when there is none: why
+  int width = 0, height = 0;
+  std::vector<std::int32_t> leaf;
+  int leaves = 0;     // in the whole tree
+  int on_screen = 0;  // distinct leaves in `leaf`
+  int pass = 0;       // the training passes it has learned from
+};
+
 bool build_view_layer(ViewMode mode, const PublishedImage& image, const ReferenceImage* reference, ViewLayer& out,
                       std::string& why, const LayerOptions* options = nullptr,  // null: the mode's defaults
-                      const WeightMaps* maps = nullptr);
+                      const WeightMaps* maps = nullptr, const GuidingLeafMap* leaves = nullptr);
 
 }  // namespace pdflab::ui

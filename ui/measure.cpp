@@ -196,7 +196,8 @@ bool MeasureState::refresh_layer(const MeasureSettings& settings) {
   layer_mode = mode;
   layer_options = options;
   layer_why.clear();
-  layer_ok = build_view_layer(mode, published, matching_reference(), layer, layer_why, &options, &weight_maps);
+  layer_ok = build_view_layer(mode, published, matching_reference(), layer, layer_why, &options, &weight_maps,
+                              &guiding_leaves);
   if (!layer_ok && mode == ViewMode::Difference && reference.loaded() && !matching_reference())
     layer_why = reference_mismatch();
   return layer_ok;

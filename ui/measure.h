@@ -162,10 +162,17 @@ struct MeasureState {
   std::string layer_why;        // why not, when the mode is not Image
   ViewLayer layer;
   WeightMaps weight_maps;       // set by the viewer's weight prediction
+  GuidingLeafMap guiding_leaves;  // set by the viewer from the session's path guiding
 
   // New weight maps: the layer follows.
   void set_weight_maps(WeightMaps maps) {
     weight_maps = std::move(maps);
+    layer_ok = false;
+    layer_why.clear();
+  }
+  // A new guiding-tree map: the layer follows.
+  void set_guiding_leaves(GuidingLeafMap map) {
+    guiding_leaves = std::move(map);
     layer_ok = false;
     layer_why.clear();
   }

@@ -214,6 +214,15 @@ void draw_legend_window(const ViewerSettings& settings, const MeasureState& m) {
         ImGui::Text("%s: %llu px", names[r], static_cast<unsigned long long>(n));
       }
       ImGui::TextColored(kDim, total == 0 ? "No pixel dropped a sample." : "Other pixels are dimmed.");
+    } else if (mode == ViewMode::GuidingTree) {
+      const GuidingLeafMap& g = m.guiding_leaves;
+      ImGui::Text("%d of the tree's %d leaves in view, learned from %d training pass%s", g.on_screen, g.leaves, g.pass,
+                  g.pass == 1 ? "" : "es");
+      ImGui::TextColored(kDim,
+                         "Each colour is one leaf of the S-tree: a box of the scene in which the surfaces facing one "
+                         "way share one learned distribution of directions (a quadtree). A leaf splits when its "
+                         "records outgrow the pass's threshold, so leaves are small where many paths arrive. Click a "
+                         "pixel (P) for its leaf's quadtree.");
     } else {
       const LayerOptions& o = m.layer_options;
       ImGui::TextColored(kDim, "%s", m.layer.scale.title.c_str());

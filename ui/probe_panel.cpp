@@ -2,6 +2,8 @@
 #include "ui/style.h"
 
 #include "renderer/error.h"
+#include "ui/colour_scale.h"
+#include "ui/layout_report.h"
 #include "ui/teach_draw.h"
 
 #include <imgui.h>
@@ -98,6 +100,32 @@ void draw_disc(ImDrawList* list, ImVec2 centre, float radius, const char* label)
   list->AddLine(ImVec2(centre.x, centre.y - radius), ImVec2(centre.x, centre.y + radius), IM_COL32(55, 55, 65, 255));
   const float w = ImGui::CalcTextSize(label).x;
   list->AddText(ImVec2(centre.x - w * 0.5f, centre.y + radius + 3.0f), IM_COL32(175, 175, 185, 255), label);
+}
+
+// The quadtree of the probe point's leaf as a picture of its cells: the map
+// (s, t) = ((z + 1) / 2, phi / 2 pi) of the scene's axes, s across and t down,
+// each cell coloured by its pdf on the guided map's scale (`top`), the cells
+// facing into the surface dimmed, and a ring where the normal points.
+void quadtree_view(const ProbeState& s, float side, bool log_scale, double top) {
+  ImGui::Text("leaf %d's quadtree: %zu cells", s.guide_leaf, s.guide_cells.size());
+  const ImVec2 p0 = ImGui::GetCursorScreenPos();
+  ImGui::Dummy(ImVec2(side, side));
+  layout::item("probe.quadtree");
+  ImDrawList* list = ImGui::GetWindowDrawList();
+  if (top <= 0.0) top = 1.0;
+  for (const GuidingDistribution::Cell& c : s.guide_cells) {
+    const double v = c.pdf;
+    const double t = log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top;
+    const ImVec2 a(p0.x + side * c.s, p0.y + side * c.t), b(p0.x + side * (c.s + c.size), p0.y + side * (c.t + c.size));
+    list->AddRectFilled(a, b, draw::colormap(static_cast<float>(t)));
+    const Vec3 d = direction_from_square(c.s + 0.5f * c.size, c.t + 0.5f * c.size);
+    if (dot(d, s.point.normal) < 0.0f) list->AddRectFilled(a, b, IM_COL32(0, 0, 0, 140));
+    if (b.x - a.x >= 3.0f) list->AddRect(a, b, IM_COL32(20, 20, 26, 200));
+  }
+  const SquarePoint n = square_from_direction(s.point.normal);
+  const ImVec2 at(p0.x + side * n.s, p0.y + side * n.t);
+  list->AddCircle(at, 5.0f, IM_COL32(255, 255, 255, 230), 16, 2.0f);
+  list->AddRect(p0, ImVec2(p0.x + side, p0.y + side), IM_COL32(110, 110, 120, 255));
 }
 
 bool is_light_technique(int t) {
@@ -385,6 +413,13 @@ void probe_pixel(ProbeState& s, std::shared_ptr<const Scene> scene, const Strate
                      ? make_map("guided alone: what the SD-tree learned here", *s.scene,
                                 Strategy::single(Technique::Guided), s.point, kMapWidth, kMapHeight, s.guide.get())
                      : ProbeMap{};
+  s.guide_leaf = -1;
+  s.guide_cells.clear();
+  if (!s.guided_map.values.empty() && s.point.found) {
+    s.guide_leaf = s.guide->leaf_at(s.point.point, s.point.normal);
+    s.guide->leaf_box(s.point.point, s.point.normal, s.guide_box_lo, s.guide_box_hi);
+    s.guide_cells = s.guide->cells(s.guide_leaf);
+  }
   // The brute-force incident light, for comparison with what guiding learned
   // (a job still running for an earlier probe is waited for: a few tenths of a second).
   s.incident_map = ProbeMap{};
@@ -530,6 +565,40 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
       draw_map(s.incident_map, ImVec2(map_h * 2.0f, map_h), s.log_scale, guided_top);
     } else if (s.incident_running()) {
       ImGui::TextColored(kDim, "tracing the light that arrives here (%d paths a cell)...", kIncidentPaths);
+    }
+    if (s.guide_leaf >= 0) {
+      // The tree itself: the leaf's cells in the map the SD-tree keeps, on the same colour scale.
+      ImGui::BeginGroup();
+      quadtree_view(s, map_h * 1.4f, s.log_scale, guided_top);
+      ImGui::EndGroup();
+      ImGui::SameLine();
+      ImGui::BeginGroup();
+      const Colour leaf_colour = guiding_leaf_colour(s.guide_leaf);
+      const ImVec2 q = ImGui::GetCursorScreenPos();
+      const float sw = ImGui::GetFontSize();
+      ImGui::GetWindowDrawList()->AddRectFilled(
+          ImVec2(q.x, q.y + 2.0f), ImVec2(q.x + sw, q.y + sw - 2.0f),
+          IM_COL32(static_cast<int>(leaf_colour[0] * 255.0f), static_cast<int>(leaf_colour[1] * 255.0f),
+                   static_cast<int>(leaf_colour[2] * 255.0f), 255));
+      ImGui::Dummy(ImVec2(sw, sw));
+      ImGui::SameLine();
+      ImGui::Text("leaf %d of %d", s.guide_leaf, s.guide->leaves());
+      const auto lo = file_point(*s.scene, s.guide_box_lo), hi = file_point(*s.scene, s.guide_box_hi);
+      float smallest = 1.0f;
+      for (const GuidingDistribution::Cell& c : s.guide_cells) smallest = std::min(smallest, c.size);
+      const int depth = -std::ilogb(smallest);  // cells are halves of halves
+      static constexpr const char* kFacing[kGuidingNormalBins] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+      ImGui::PushStyleColor(ImGuiCol_Text, kDim);
+      ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + std::max(120.0f, avail - map_h * 1.4f - spacing));
+      ImGui::TextWrapped("its box: x %.3g..%.3g, y %.3g..%.3g, z %.3g..%.3g, for the surfaces facing %s", lo[0],
+                         hi[0], lo[1], hi[1], lo[2], hi[2], kFacing[guiding_normal_bin(s.point.normal)]);
+      ImGui::TextWrapped("the smallest cell %d levels down (1/%d of the map's side)", depth, 1 << depth);
+      ImGui::TextWrapped("s = (z + 1) / 2 across, t = phi / 2 pi down, in the scene's axes: equal areas are equal "
+                         "solid angles. Ring: the normal; dimmed: directions into the surface. The colour bar "
+                         "above holds.");
+      ImGui::PopTextWrapPos();
+      ImGui::PopStyleColor();
+      ImGui::EndGroup();
     }
   }
   ImGui::PushStyleColor(ImGuiCol_Text, kDim);

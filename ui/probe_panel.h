@@ -4,6 +4,7 @@
 // pdf as a lat-long map, the light lobe and the material's own (bsdf) lobe
 // alone on one colour scale, and a chi-square check run off the UI thread.
 #include "renderer/metrics/probe.h"
+#include "renderer/sampling/guiding.h"
 #include "renderer/sampling/strategy.h"
 #include "renderer/scene/scene.h"
 
@@ -76,6 +77,11 @@ struct ProbeState {
   ProbeMap incident_map;
   std::future<std::vector<float>> incident_job;
   int incident_serial = 0;  // the probe the running job belongs to
+  // The quadtree `guided` draws from here: the S-tree leaf holding the point
+  // (-1: no trained `guided`), its box and its D-tree's cells.
+  int guide_leaf = -1;
+  Vec3 guide_box_lo{0.0f}, guide_box_hi{0.0f};
+  std::vector<GuidingDistribution::Cell> guide_cells;
   std::string bsdf_lobe;   // what the material's own lobe is here, in words
   std::string delta_note;  // the clicked surface is glass or metal: its delta lobe, in words
   ProbeLightChoice light_choice;  // each light's probability at the point

@@ -9,6 +9,8 @@
 # open on the training's figures) is
 #   SHOT_SCENE=assets/scenes/door_ajar.json SHOT_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" \
 #   SHOT_OPEN=section.2 SHOT_OUT=docs/guiding_viewer.png tests/gui/capture_docs_screenshot.sh "" 15
+# SHOT_VIEW starts in a view mode; docs/guiding_tree.png (the S-tree over the
+# image) is the same with SHOT_VIEW=guiding-tree, no SHOT_OPEN, and 25 seconds.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 inside_xvfb "1400x900x24" "xdotool import" "$0" "$@"
@@ -21,7 +23,7 @@ pdflab=${1:-}
 seconds=${2:-30}
 out=${SHOT_OUT:-docs/viewer.png}
 start_viewer "$pdflab" --scene "${SHOT_SCENE:-assets/scenes/cornell_book.json}" \
-  --strategy "${SHOT_STRATEGY:-mix:cosine=0.5,light=0.5}"
+  --strategy "${SHOT_STRATEGY:-mix:cosine=0.5,light=0.5}" ${SHOT_VIEW:+--view "$SHOT_VIEW"}
 [ -z "${SHOT_OPEN:-}" ] || click "$SHOT_OPEN"
 sleep "$seconds"
 mkdir -p "$(dirname "$root/$out")"

@@ -38,8 +38,9 @@ for i in "${!modes[@]}"; do
   import -window "$wid" "$art/window_${modes[$i]}.png"
   convert "$art/window_${modes[$i]}.png" -crop "$crop" +repage "$art/${modes[$i]}.png"
 done
-# Back to the image: past the two weight views (best weight, technique share; gui_weights.sh checks them).
-for _ in 1 2 3; do send_key v; sleep 0.2; done
+# Back to the image: past the two weight views (best weight, technique share;
+# gui_weights.sh checks them) and path guiding's tree (gui_guiding.sh).
+for _ in 1 2 3 4; do send_key v; sleep 0.2; done
 
 echo "== the heat map's error metric (E) and its range (the panel)"
 send_key space   # paused: every change below is the control's doing

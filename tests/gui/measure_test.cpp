@@ -596,6 +596,36 @@ TEST(WeightViews, BestWeightLegendRunsFromZeroToOneAndGreyMeansNone) {
   EXPECT_THROW(parse_view_mode("sideways"), pdflab::InputError);
 }
 
+// The guiding-tree view: each leaf a translucent colour of its own, solid
+// borders where the leaf changes, the image left alone where no leaf is.
+TEST(ViewLayers, GuidingTreeColoursLeavesAndDrawsTheirBorders) {
+  GuidingLeafMap map;
+  map.width = 4;
+  map.height = 2;
+  map.leaf = {3, 3, 8, -1,  //
+              3, 3, 8, 8};
+  ViewLayer layer;
+  std::string why;
+  ASSERT_TRUE(build_view_layer(ViewMode::GuidingTree, {}, nullptr, layer, why, nullptr, nullptr, &map)) << why;
+  ASSERT_EQ(layer.rgba.size(), 4u * 8u);
+  const auto alpha = [&](int x, int y) { return layer.rgba[static_cast<std::size_t>((y * 4 + x) * 4 + 3)]; };
+  EXPECT_EQ(alpha(0, 0), 110);  // inside leaf 3
+  EXPECT_EQ(alpha(1, 0), 230);  // leaf 3 meets leaf 8 to its right: a border
+  EXPECT_EQ(alpha(2, 0), 230);  // leaf 8 meets nothing to its right
+  EXPECT_EQ(alpha(3, 0), 0);    // no surface: the image shows
+  EXPECT_EQ(alpha(3, 1), 110);
+  // Two leaves' insides differ in colour.
+  EXPECT_NE(std::vector<std::uint8_t>(layer.rgba.begin(), layer.rgba.begin() + 3),
+            std::vector<std::uint8_t>(layer.rgba.begin() + 7 * 4, layer.rgba.begin() + 7 * 4 + 3));
+  for (int a = 0; a < 6; ++a)
+    for (int b = a + 1; b < 6; ++b) EXPECT_NE(guiding_leaf_colour(a), guiding_leaf_colour(b)) << a << ", " << b;
+  GuidingLeafMap none;
+  none.why = "render a strategy with guided";
+  EXPECT_FALSE(build_view_layer(ViewMode::GuidingTree, {}, nullptr, layer, why, nullptr, nullptr, &none));
+  EXPECT_EQ(why, none.why);
+  EXPECT_EQ(parse_view_mode("guiding-tree"), ViewMode::GuidingTree);
+}
+
 }  // namespace
 
 TEST(ReferenceIdentity, ACameraSceneDepthOrSizeChangeTurnsTheFiguresToEstimatesAndSaysWhy) {
