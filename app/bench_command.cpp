@@ -39,6 +39,7 @@ struct Result {
   double weight = -1.0;     // with --predict: A's share of the pair; -1 outside the family
   double predicted = -1.0;  // the efficiency predicted from the pilot's paths; -1: none
   double predicted_share = -1.0;  // the largest pilot path's share of that prediction's second moment; -1: none
+  std::shared_ptr<const GuidingDistribution> guiding;  // what the run learned (a strategy with `guided`)
 };
 
 // Samples per pixel of the pilot's run replayed for the prediction (as sweep).
@@ -123,8 +124,9 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   const MeasuredRun run = render_measured(scene, strategy, o.seed, {o.seconds, o.spp, o.threads}, label, show_progress,
                                           [&](RenderSession& session) {
     ImageInfo info;
-    // The info describes the very image copied (its pass's spp and time); previews are not estimates.
-    if (session.copy_image(image, info, version) && !info.preview && info.spp > 0) {
+    // The info describes the very image copied (its pass's spp and time); previews are not estimates,
+    // and path guiding's training passes are discarded.
+    if (session.copy_image(image, info, version) && !info.preview && info.training_pass == 0 && info.spp > 0) {
       const RelMseMeasure m = measure_relmse(image, reference.rgb, reference.variance);
       r.curve.push_back({info.spp, info.seconds, rmse(image, reference.rgb), m.corrected, m.raw});
     }
@@ -138,6 +140,7 @@ Result run_one(const std::shared_ptr<const Scene>& scene, const Strategy& strate
   r.efficiency = efficiency(r.error.corrected, r.seconds);
   r.estimated_relmse = estimated_relmse(run.film);
   r.samples_per_second = st.samples_per_second;
+  r.guiding = run.guiding;
   r.dropped = st.dropped.total();
   if (r.curve.empty() || r.curve.back().spp != r.spp)
     r.curve.push_back({r.spp, r.seconds, r.rmse, r.error.corrected, r.error.raw});
@@ -203,6 +206,7 @@ double predict_members(const BenchPlan& plan, const BenchOptions& o, std::vector
   po.seed = o.seed;
   po.samples = std::min(pilot.spp, kPredictionSpp);
   po.threads = o.threads;
+  po.guiding = pilot.guiding.get();  // the pilot's own, frozen: the prediction at every weight uses it
   const WeightPredictor predictor =
       record_weight_paths(*plan.scene, prediction.pair.mixture_family(), pilot.strategy, w, grid, po);
   const double seconds_per_sample = pilot.seconds / pilot.spp;

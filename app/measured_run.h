@@ -25,6 +25,8 @@ struct RunLimit {
 struct MeasuredRun {
   Film film;           // the accumulation when the run stopped
   SessionStats stats;  // its spp, seconds, samples per second, drops
+  // Path guiding's distribution the run rendered with (null: no `guided`).
+  std::shared_ptr<const GuidingDistribution> guiding;
 };
 
 // `on_poll` (optional) sees the session after every wait, e.g. to copy the

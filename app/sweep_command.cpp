@@ -137,6 +137,7 @@ struct Run {
   std::uint32_t spp = 0;
   double seconds = 0.0, relmse = 0.0, efficiency = 0.0, samples_per_second = 0.0;
   double cost_seconds = 0.0;  // what the run is priced by: `seconds`, or its CPU time with --cpu-time
+  std::shared_ptr<const GuidingDistribution> guiding;  // what it learned (a mixture with `guided`)
 };
 
 // The process's CPU time so far, user and system, over all its threads.
@@ -163,6 +164,7 @@ Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strat
   if (image) *image = mean;
   r.efficiency = efficiency(r.relmse, r.cost_seconds);
   r.samples_per_second = run.stats.samples_per_second;
+  r.guiding = run.guiding;
   return r;
 }
 
@@ -409,6 +411,7 @@ SweepPlan plan_sweep(const SweepOptions& o) {
   SweepPlan plan;
   plan.weights = parse_weights(o.weights);
   plan.family = parse_technique_pair(o.vary, o.strategy, o.roulette_depth);
+  if (o.auto_weight && plan.family.at(0.5).uses(Technique::Guided)) throw InputError(std::string("--auto: ") + kGuidedNoAutoWeight);
   plan.scene = std::make_shared<Scene>(load_scene_file(o.scene));
   // Every strategy of the sweep is checked against the scene before the first render.
   for (double w : plan.weights) {
@@ -457,6 +460,7 @@ void predict_from_pilot(const SweepPlan& plan, const SweepOptions& o, const Row&
   po.samples = std::min({run.spp, kPredictionSpp,
                          static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (kPredictionPaths + pixels - 1) / pixels))});
   po.threads = o.threads;
+  po.guiding = run.guiding.get();  // the pilot's own, frozen: the prediction at every weight uses it
   const WeightPredictor predictor = record_weight_paths(scene, plan.mixture_family, row.strategy, row.weight, plan.grid, po);
   if (!o.map.empty() && runs.map_png.empty())
     runs.map_png = best_weight_png(predictor, plan.reference.rgb, scene.camera.width, scene.camera.height);

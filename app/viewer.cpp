@@ -1279,6 +1279,11 @@ void Viewer::Impl::service_weights() {
   in.b = mixture ? pair[1] : -1;
   in.image = &measure.published;
   in.pricing = auto_run.on ? &auto_run.chooser : nullptr;
+  if (in.strategy.uses(Technique::Guided)) {
+    in.guiding = session->guiding();
+    const SessionStats st = session->stats();  // after the distribution: its passes are at least as many
+    in.guiding_trained = st.guiding_pass >= st.guiding_passes;
+  }
   if (weight_lab->update(in)) {
     measure.set_weight_maps(weight_lab->maps());
     settle_frames = std::max(settle_frames, 1);
@@ -1319,7 +1324,9 @@ void Viewer::Impl::service_guiding_tree() {
 // unbiased render and so is the film that sums them (docs/measuring.md).
 void Viewer::Impl::service_auto_weight() {
   const std::array<int, 2> pair = ui::two_technique_pair(applied.sampling, panel.w_pair);
-  const bool usable = settings.auto_weight && applied.sampling.mixture && !applied.sampling.nee_mis && pair[0] >= 0;
+  // Not with guided: each pass would train path guiding anew (kGuidedNoAutoWeight).
+  const bool usable = settings.auto_weight && applied.sampling.mixture && !applied.sampling.nee_mis && pair[0] >= 0 &&
+                      !applied.sampling.strategy().uses(Technique::Guided);
   if (!usable) {
     auto_run.on = false;
     return;

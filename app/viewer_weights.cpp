@@ -145,19 +145,28 @@ bool WeightLab::update(const Input& in) {
     reset(in.generation);
     changed = true;
   }
-  if (in.a == static_cast<int>(Technique::Guided) || in.b == static_cast<int>(Technique::Guided) ||
-      in.strategy.uses(Technique::Guided)) {
-    // No curve rather than the untrained sphere's.
-    if (curve_.active || curve_.why != kGuidedNotPredicted) changed = true;
+  if (in.strategy.uses(Technique::Guided) && (!in.guiding_trained || !in.guiding)) {
+    // No curve rather than the untrained sphere's: the prediction replays
+    // paths with the distribution the render draws from once it has learned.
+    static constexpr const char* kWaiting = "waiting for path guiding's training passes";
+    if (curve_.active || curve_.why != kWaiting) changed = true;
     curve_ = {};
-    curve_.why = kGuidedNotPredicted;
+    curve_.why = kWaiting;
     maps_ = {};
     maps_.why = curve_.why;
     return changed;
   }
+  // The pair's names as the strategy writes its terms: a technique with a
+  // parameter carries it (cosine-power:8, guided:5), and weight_of matches names.
+  const auto term_name = [&](int t) {
+    const std::string base(technique_name(static_cast<Technique>(t)));
+    for (const auto& term : mixture_terms(in.strategy))
+      if (term.first == base || term.first.rfind(base + ":", 0) == 0) return term.first;
+    return base;
+  };
   TechniquePair pair;
-  pair.a = std::string(technique_name(static_cast<Technique>(in.a)));
-  pair.b = std::string(technique_name(static_cast<Technique>(in.b)));
+  pair.a = term_name(in.a);
+  pair.b = term_name(in.b);
   pair.roulette_depth = in.strategy.roulette_depth;  // the paths' own (the prediction weighs its checks)
   maps_.a = pair.a;
   maps_.b = pair.b;
@@ -174,7 +183,9 @@ bool WeightLab::update(const Input& in) {
     maps_.why = why;
     return changed;
   }
-  if (job_.valid() || !info || info->preview || info->generation != in.generation || info->spp == 0) return changed;
+  if (job_.valid() || !info || info->preview || info->training_pass > 0 || info->generation != in.generation ||
+      info->spp == 0)
+    return changed;
   const std::uint32_t drawn = info->spp > in.spp_before ? info->spp - in.spp_before : 0;
   const std::uint32_t wanted = std::min(drawn, kMaxSpp);
   if (traced_ + kRoundSpp > wanted) return changed;
@@ -195,6 +206,8 @@ bool WeightLab::update(const Input& in) {
   round->options.samples = kRoundSpp;
   round->options.threads = 1;  // beside the render's threads
   round->options.block = block;
+  round->guiding = in.guiding;  // frozen for the generation once trained
+  round->options.guiding = round->guiding.get();
   round->grid = AutoWeight().grid();
   round->predictor = std::move(predictor_);
   round->share = std::move(share_);

@@ -48,6 +48,10 @@ class WeightLab {
     // Prices the curve: auto weight's chooser while it runs (its cost model
     // fitted to its passes); null: a fresh one (the prior fixed cost).
     const AutoWeight* pricing = nullptr;
+    // A strategy with `guided`: the render's distribution, and whether its
+    // training passes are over (the prediction waits for the frozen one).
+    std::shared_ptr<const GuidingDistribution> guiding;
+    bool guiding_trained = false;
   };
   // Once a frame. Starts a round when one is due, takes a finished one.
   // Returns true when the curve or the maps changed.
@@ -69,6 +73,7 @@ class WeightLab {
     Strategy strategy;
     double w = 0.5;
     WeightPathOptions options;
+    std::shared_ptr<const GuidingDistribution> guiding;  // what options.guiding points to, kept alive
     std::vector<double> grid;
     std::unique_ptr<WeightPredictor> predictor;  // what earlier rounds traced, or null
     std::vector<double> share;

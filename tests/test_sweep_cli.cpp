@@ -111,10 +111,10 @@ TEST_F(SweepCommand, BadTechniquesAreBadInput) {
   expect_bad_input(with({"--vary", "cosine,light", "--strategy", "uniform-sphere"}), "no weight");
   expect_bad_input(with({"--vary", "cosine,light", "--seeds", "0"}), "--seeds");
   expect_bad_input(with({"--vary", "cosine,light", "--seconds", "1"}), "exactly one");
-  // Path guiding's density is learned by each render: the prediction cannot replay it.
-  expect_bad_input(with({"--vary", "cosine,guided"}), "weight prediction cannot see");
-  expect_bad_input(with({"--vary", "cosine,light", "--strategy", "mix:cosine=1,light=1,guided=1"}),
-                   "weight prediction cannot see");
+  // Path guiding is trained by each render: auto weight's passes of one film would each train anew.
+  expect_bad_input(with({"--vary", "cosine,guided", "--auto"}), "auto weight does not take a mixture with guided");
+  expect_bad_input(with({"--vary", "cosine,light", "--strategy", "mix:cosine=1,light=1,guided=1", "--auto"}),
+                   "--auto: auto weight does not take");
   // At weight 0 the mixture is `light` alone, and this scene has no importance targets.
   const std::string no_targets = in_work("no_targets.json");
   {

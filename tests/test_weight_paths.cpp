@@ -5,6 +5,7 @@
 #include "renderer/error.h"
 #include "renderer/integrator/integrator.h"
 #include "renderer/metrics/weight_paths.h"
+#include "renderer/sampling/guiding.h"
 #include "renderer/scene/scene_loader.h"
 
 #include <gtest/gtest.h>
@@ -116,6 +117,50 @@ TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
     EXPECT_NEAR(predicted, measured, 0.1 * measured) << "at " << w;
     // And the difference between weights is real, so the test can tell them apart.
     EXPECT_GT(std::fabs(image_moment(drawn_half, 1, mean) - measured), 0.1 * measured) << "at " << w;
+  }
+}
+
+// A mixture of cosine and a trained `guided`: with the distribution frozen
+// (WeightPathOptions::guiding, as a render's replay passes it), the moment
+// predicted at w from paths drawn at 0.5 matches the one measured from paths
+// drawn at w; the untrained sphere in its place predicts another.
+TEST(WeightPaths, PredictionWithAFrozenGuideMatchesTheMeasuredOne) {
+  const Scene scene = small_box(12);
+  GuidingTrainer trainer(scene);
+  const Vec3 lo = trainer.distribution()->lo(), hi = trainer.distribution()->hi();
+  Rng rng(4, 4);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < 200000; ++i) {
+      const Vec3 p = lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+      const Vec3 d = direction_from_square(rng.uniform(), rng.uniform());
+      const double energy = d.y > 0.85f ? 50.0 : 1.0;  // light from above, as the book's lamp gives
+      trainer.record(p, Vec3(0.0f, 1.0f, 0.0f), d, energy * 4.0 * 3.14159265358979);
+    }
+    trainer.finish_pass();
+  }
+  const std::shared_ptr<const GuidingDistribution> guide = trainer.distribution();
+  ASSERT_GT(guide->leaves(), kGuidingNormalBins);
+  MixtureFamily family;
+  family.a = Strategy::parse("cosine");
+  family.b = Strategy::parse("guided");
+  const auto drawn = [&](double w, std::uint64_t seed, const GuidingDistribution* g) {
+    char text[64];
+    std::snprintf(text, sizeof text, "mix:cosine=%g,guided=%g", w, 1.0 - w);
+    WeightPathOptions o;
+    o.samples = 2048;
+    o.threads = 2;
+    o.seed = seed;
+    o.guiding = g;
+    return record_weight_paths(scene, family, Strategy::parse(text), w, {0.25, 0.5, 0.8}, o);
+  };
+  const std::vector<float> mean = mean_image(scene);
+  const WeightPredictor drawn_half = drawn(0.5, 11, guide.get());
+  const WeightPredictor untrained_half = drawn(0.5, 11, nullptr);
+  for (double w : {0.25, 0.8}) {
+    const std::size_t g = w < 0.5 ? 0 : 2;
+    const double measured = image_moment(drawn(w, 21, guide.get()), g, mean);
+    EXPECT_NEAR(image_moment(drawn_half, g, mean), measured, 0.1 * measured) << "at " << w;
+    EXPECT_GT(std::fabs(image_moment(untrained_half, g, mean) - measured), 0.1 * measured) << "at " << w;
   }
 }
 

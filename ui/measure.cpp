@@ -112,7 +112,9 @@ bool label_unbiased(const std::string& label) {
 
 void MeasureState::on_image(std::uint64_t current_generation, const std::string& label) {
   const bool unbiased = label_unbiased(label);
-  if (!published.info.preview && published.info.spp > 0) {
+  // A path guiding training pass is shown but discarded: it is no point of the film's history or curve.
+  const bool kept = !published.info.preview && published.info.training_pass == 0;
+  if (kept && published.info.spp > 0) {
     if (published.info.generation != history_generation) {
       history.clear();
       history_generation = published.info.generation;
@@ -122,7 +124,7 @@ void MeasureState::on_image(std::uint64_t current_generation, const std::string&
   figures = compute_figures(published.info, published.rgb, matching_reference(), unbiased);
   figures.estimate_why = reference.loaded() ? reference_mismatch() : std::string();
   figures.estimate_unreliable = history.unreliable_now();
-  if (figures.valid && published.info.generation == current_generation)
+  if (kept && figures.valid && published.info.generation == current_generation)
     curves.record(published.info.generation, label, !figures.against_reference, figures.spp, figures.seconds,
                   figures.plot_error(), published.info.width, published.info.height);
   layer_ok = false;

@@ -96,7 +96,6 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
     }
     if (s.nee_mis || s.to_string().rfind("mix:", 0) == 0)
       throw InputError("--vary '" + vary + "': '" + *name + "' is not a mixture technique");
-    if (s.uses(Technique::Guided)) throw InputError("--vary '" + vary + "': " + kGuidedNotPredicted);
     *name = s.to_string();  // canonical, as the base mixture's terms are written
   }
   if (f.a == f.b) throw InputError("--vary '" + vary + "' names the same technique twice");
@@ -105,7 +104,6 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
   if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
   s.roulette_depth = 0;  // the mixture's terms alone
   if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
-  if (s.uses(Technique::Guided)) throw InputError("--strategy '" + base + "': " + kGuidedNotPredicted);
   double pair = 0.0;
   for (const auto& [name, weight] : mixture_terms(s))
     if (name == f.a || name == f.b)
@@ -121,11 +119,16 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
 
 WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& family, const Strategy& mixture,
                                     double w, const std::vector<double>& grid, const WeightPathOptions& o) {
-  const SamplingPlan plan = SamplingPlan::make(mixture, scene);
-  const SamplingPlan plan_a = SamplingPlan::make(family.a, scene);
-  const SamplingPlan plan_b = SamplingPlan::make(family.b, scene);
+  const auto make = [&](const Strategy& s) {
+    SamplingPlan p = SamplingPlan::make(s, scene);
+    p.guiding = o.guiding;
+    return p;
+  };
+  const SamplingPlan plan = make(mixture);
+  const SamplingPlan plan_a = make(family.a);
+  const SamplingPlan plan_b = make(family.b);
   const bool has_rest = family.share < 1.0;
-  const SamplingPlan plan_rest = has_rest ? SamplingPlan::make(family.rest, scene) : SamplingPlan{};
+  const SamplingPlan plan_rest = has_rest ? make(family.rest) : SamplingPlan{};
   const float rest_weight = static_cast<float>(1.0 - family.share);
   const int width = scene.camera.width, height = scene.camera.height;
   const WeightFamily weights{family.share, plan.roulette_depth > 0};

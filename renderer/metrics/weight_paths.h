@@ -38,12 +38,13 @@ struct TechniquePair {
   double weight_of(const Strategy& s) const;
 };
 
-// Why a mixture with `guided` is not swept or predicted: the prediction
-// replays paths with each technique's density, and path guiding's density is
-// learned by the render's own training passes, which the replay cannot see.
-inline constexpr const char* kGuidedNotPredicted =
-    "guided's density is learned by each render's training passes, which the weight prediction cannot see: "
-    "a mixture with guided is not swept or predicted yet (docs/guiding.md)";
+// Why auto weight refuses a mixture with `guided`: its passes continue one
+// film at changing weights, and each would train a distribution of its own
+// (the prediction of a fixed render uses the one that render learned:
+// WeightPathOptions::guiding).
+inline constexpr const char* kGuidedNoAutoWeight =
+    "auto weight does not take a mixture with guided: each of its passes would train path guiding anew "
+    "(docs/guiding.md)";
 
 // "A,B" (a comma between two technique names) with an optional base mixture
 // whose other techniques keep their weights, and Russian roulette from
@@ -72,6 +73,11 @@ struct WeightPathOptions {
   // auto weight needs, without a per-pixel table to allocate every pass.
   const std::vector<float>* relative_to = nullptr;
   double relative_epsilon = 0.0;
+  // `guided`'s distribution, frozen, for every member of the family: the one
+  // the render being replayed learned (null: untrained, the uniform sphere).
+  // The prediction then says what each weight would give with that
+  // distribution; a render at another weight trains its own.
+  const GuidingDistribution* guiding = nullptr;
 };
 
 // The image-wide prediction of a predictor recorded with `relative_to` =

@@ -3,7 +3,8 @@
 # small: the guiding-tree view (--view guiding-tree) draws the S-tree's leaves
 # over the image once a guided strategy has trained, and falls back to the
 # image, with a legend saying why, for a strategy without `guided`; the pixel
-# probe draws the clicked point's quadtree, its cells in more than one colour.
+# probe draws the clicked point's quadtree, its cells in more than one colour;
+# a cosine/guided mixture gets its predicted efficiency curve once trained.
 #   gui_guiding.sh PDFLAB SCENE ARTIFACT_DIR
 # Exit 77 only when xvfb-run is missing (see gui_smoke.sh).
 set -euo pipefail
@@ -74,5 +75,13 @@ read -r mean sd <<<"$(identify -format "%[fx:mean] %[fx:standard_deviation]" "$a
 echo "quadtree: mean=$mean sd=$sd"
 awk -v m="$mean" -v s="$sd" 'BEGIN { exit !(m > 0.03 && s > 0.05) }' || fail "the quadtree looks blank or flat"
 shot probe
+quit_viewer
+
+echo "== a cosine/guided mixture: the predicted curve once training is over"
+start_viewer "$pdflab" --scene "$art/door.json" --strategy "mix:cosine=0.5,guided:3=0.5"
+curve=$(crop_of sampling.curve)
+shot curve_early "$curve"  # the curve waits for the training passes
+sleep 8
+await_changed "$art/curve_early.png" curve "$curve" 0.02
 quit_viewer
 echo "gui_guiding: ok"
