@@ -264,10 +264,12 @@ struct Viewer::Impl {
   void service_weights();
   void service_auto_weight();
   void service_guiding_tree();
-  // What the guiding-tree view's map was made from.
+  // What the guiding-tree view's map was made from, and the job making one
+  // (a ray per pixel: off the UI thread, whatever the resolution).
   std::shared_ptr<const GuidingDistribution> leaf_map_guide;
   std::shared_ptr<const Scene> leaf_map_scene;
   bool leaf_map_made = false;
+  std::future<ui::GuidingLeafMap> leaf_map_job;
 
   // The steps of a frame, in order (see Viewer::frame).
   struct FrameLayout;
@@ -1293,6 +1295,12 @@ void Viewer::Impl::service_weights() {
 // The guiding-tree view: while it is on, its map follows the session's
 // distribution (a new one at the end of each training pass).
 void Viewer::Impl::service_guiding_tree() {
+  if (leaf_map_job.valid()) {
+    if (leaf_map_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    // Of leaf_map_guide: no other job starts while one runs.
+    measure.set_guiding_leaves(leaf_map_job.get());
+    settle_frames = std::max(settle_frames, 1);
+  }
   if (settings.measure.view_mode != ui::ViewMode::GuidingTree) return;
   std::shared_ptr<const GuidingDistribution> guide = session->guiding();
   if (leaf_map_made && guide == leaf_map_guide && render_scene == leaf_map_scene) return;
@@ -1300,21 +1308,25 @@ void Viewer::Impl::service_guiding_tree() {
   leaf_map_made = true;
   leaf_map_guide = guide;
   leaf_map_scene = render_scene;
-  ui::GuidingLeafMap map;
   if (!guide) {
+    ui::GuidingLeafMap map;
     map.why = "render a strategy with guided (its training builds the tree), e.g. nee-mis+mix:cosine=0.5,guided=0.5";
-  } else {
-    map.width = render_scene->camera.width;
-    map.height = render_scene->camera.height;
-    map.leaf = guiding_leaf_map(*render_scene, *guide);
+    measure.set_guiding_leaves(std::move(map));
+    settle_frames = std::max(settle_frames, 1);
+    return;
+  }
+  leaf_map_job = std::async(std::launch::async, [guide, scene = render_scene, pass] {
+    ui::GuidingLeafMap map;
+    map.width = scene->camera.width;
+    map.height = scene->camera.height;
+    map.leaf = guiding_leaf_map(*scene, *guide);
     map.leaves = guide->leaves();
     map.pass = pass;
     std::vector<char> seen(static_cast<std::size_t>(map.leaves), 0);
     for (const std::int32_t l : map.leaf)
       if (l >= 0 && !std::exchange(seen[static_cast<std::size_t>(l)], 1)) ++map.on_screen;
-  }
-  measure.set_guiding_leaves(std::move(map));
-  settle_frames = std::max(settle_frames, 1);
+    return map;
+  });
 }
 
 // Auto weight: at 16, 32, 64, ... spp the weight moves to the best that the
