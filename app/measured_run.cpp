@@ -27,6 +27,7 @@ MeasuredRun render_measured(const std::shared_ptr<const Scene>& scene, const Str
   settings.seed = seed;
   settings.target_spp = limit.spp;  // 0 with a time limit: until paused
   settings.first_sample = limit.first_sample;
+  settings.guiding = limit.guiding;
   session.set_settings(settings);
   for (;;) {
     const bool done = session.wait_until_done(std::chrono::milliseconds(25));

@@ -20,13 +20,15 @@ struct RunLimit {
   std::uint32_t spp = 0;  // > 0: equal samples
   int threads = 0;
   std::uint32_t first_sample = 0;  // each pixel's first sample index (a run continuing another)
+  // Path guiding's distribution to draw from, untrained further (RenderSettings::guiding); null: its own.
+  std::shared_ptr<const GuidingDistribution> guiding = nullptr;
 };
 
 struct MeasuredRun {
   Film film;           // the accumulation when the run stopped
   SessionStats stats;  // its spp, seconds, samples per second, drops
   // Path guiding's distribution the run rendered with (null: no `guided`).
-  std::shared_ptr<const GuidingDistribution> guiding;
+  std::shared_ptr<const GuidingDistribution> guiding = nullptr;
 };
 
 // `on_poll` (optional) sees the session after every wait, e.g. to copy the

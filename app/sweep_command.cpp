@@ -150,10 +150,11 @@ double process_cpu_seconds() {
 
 Run render_once(const std::shared_ptr<const Scene>& scene, const Strategy& strategy, std::uint64_t seed,
                 const SweepOptions& o, const Reference& reference, const std::string& label,
-                bool show_progress, std::vector<float>* image = nullptr, std::uint32_t first_sample = 0) {
+                bool show_progress, std::vector<float>* image = nullptr, std::uint32_t first_sample = 0,
+                std::shared_ptr<const GuidingDistribution> guiding = nullptr) {
   const double cpu_start = process_cpu_seconds();
-  const MeasuredRun run =
-      render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads, first_sample}, label, show_progress);
+  const MeasuredRun run = render_measured(scene, strategy, seed, {o.seconds, o.spp, o.threads, first_sample, std::move(guiding)},
+                                          label, show_progress);
   Run r;
   r.spp = run.stats.spp;
   r.seconds = run.stats.seconds;
@@ -193,6 +194,9 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
   double seconds = 0.0, share = 0.0;
   const double cpu_start = process_cpu_seconds();
   std::uint32_t spp = 0;
+  // A mixture with `guided`: the first pass trains (its time counts) and every
+  // later one draws from that distribution, fixed before it starts.
+  std::shared_ptr<const GuidingDistribution> guiding;
   for (int pass = 0; pass < AutoWeight::kPasses; ++pass) {
     const double w = chooser.weight();
     out.weights.push_back(w);
@@ -208,7 +212,8 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
     // (0,2)-sequence per pixel) and random streams of a fixed-weight run of
     // as many samples; only the weights differ.
     std::vector<float> image;
-    const Run r = render_once(scene, family.at(w), seed, slice, reference, label, show_progress, &image, spp);
+    const Run r = render_once(scene, family.at(w), seed, slice, reference, label, show_progress, &image, spp, guiding);
+    if (!guiding) guiding = r.guiding;
     for (std::size_t i = 0; i < values; ++i) sum[i] += static_cast<double>(image[i]) * r.spp;
     spp += r.spp;
     seconds += r.seconds;
@@ -236,6 +241,7 @@ AutoRun render_auto(const std::shared_ptr<const Scene>& scene, const TechniquePa
     po.film = &traced;
     po.relative_to = &so_far;  // one image-wide cell: nothing per pixel to allocate
     po.relative_epsilon = kRelMseEpsilon;
+    po.guiding = guiding.get();
     const WeightPredictor predictor = record_weight_paths(*scene, mixtures, family.at(w), w, chooser.grid(), po);
     // The pass's own time per sample and its paths' rays feed the cost model.
     chooser.add_pass(predict_image_wide(predictor, so_far, r.cost_seconds / r.spp, kRelMseEpsilon),
@@ -411,7 +417,6 @@ SweepPlan plan_sweep(const SweepOptions& o) {
   SweepPlan plan;
   plan.weights = parse_weights(o.weights);
   plan.family = parse_technique_pair(o.vary, o.strategy, o.roulette_depth);
-  if (o.auto_weight && plan.family.at(0.5).uses(Technique::Guided)) throw InputError(std::string("--auto: ") + kGuidedNoAutoWeight);
   plan.scene = std::make_shared<Scene>(load_scene_file(o.scene));
   // Every strategy of the sweep is checked against the scene before the first render.
   for (double w : plan.weights) {

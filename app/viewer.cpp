@@ -1336,9 +1336,7 @@ void Viewer::Impl::service_guiding_tree() {
 // unbiased render and so is the film that sums them (docs/measuring.md).
 void Viewer::Impl::service_auto_weight() {
   const std::array<int, 2> pair = ui::two_technique_pair(applied.sampling, panel.w_pair);
-  // Not with guided: each pass would train path guiding anew (kGuidedNoAutoWeight).
-  const bool usable = settings.auto_weight && applied.sampling.mixture && !applied.sampling.nee_mis && pair[0] >= 0 &&
-                      !applied.sampling.strategy().uses(Technique::Guided);
+  const bool usable = settings.auto_weight && applied.sampling.mixture && !applied.sampling.nee_mis && pair[0] >= 0;
   if (!usable) {
     auto_run.on = false;
     return;
@@ -1381,6 +1379,8 @@ void Viewer::Impl::service_auto_weight() {
   settings.sampling.weights[a] = static_cast<float>(w);
   settings.sampling.weights[b] = static_cast<float>(1.0 - w);
   rs.strategy = settings.sampling.strategy();
+  // With guided, every later pass draws from the distribution the first one learned.
+  rs.guiding = rs.strategy.uses(Technique::Guided) ? session->guiding() : nullptr;
   try {
     session->resume(rs, FilmStart{std::move(film), st.spp, st.dropped, st.seconds});
   } catch (const InputError& e) {

@@ -315,5 +315,39 @@ TEST(GuidingSession, TrainsTheSameForAnyThreadCount) {
   EXPECT_TRUE(same_four) << "1 and 4 threads gave different images";
 }
 
+// Auto weight's later passes: a session given a distribution draws from it
+// as it is and trains nothing; given the one a trained session learned, it
+// renders that session's very image.
+TEST(GuidingSession, AGivenDistributionIsDrawnFromAsItIs) {
+  RenderSettings settings;
+  settings.scene = small_door(40, 30);
+  settings.strategy = Strategy::parse("nee-mis+mix:cosine=0.5,guided:3=0.5");
+  settings.seed = 5;
+  settings.target_spp = 4;
+  RenderSession trained(2);
+  trained.set_settings(settings);
+  ASSERT_TRUE(trained.wait_until_done(std::chrono::seconds(300)));
+  EXPECT_EQ(trained.stats().guiding_passes, 3);
+  settings.guiding = trained.guiding();
+  ASSERT_NE(settings.guiding, nullptr);
+  RenderSession given(2);
+  given.set_settings(settings);
+  ASSERT_TRUE(given.wait_until_done(std::chrono::seconds(300)));
+  EXPECT_EQ(given.stats().guiding_passes, 0);
+  EXPECT_EQ(given.stats().guiding_records, 0u);
+  EXPECT_EQ(given.guiding(), settings.guiding);
+  EXPECT_EQ(given.stats().guiding.nodes, trained.stats().guiding.nodes);
+  const Film a = trained.copy_film(), b = given.copy_film();
+  ASSERT_EQ(a.pixel_count(), b.pixel_count());
+  bool same = true;
+  for (std::size_t p = 0; p < a.pixel_count(); ++p) {
+    double x[3], y[3];
+    a.mean(p, x);
+    b.mean(p, y);
+    same = same && x[0] == y[0] && x[1] == y[1] && x[2] == y[2];
+  }
+  EXPECT_TRUE(same) << "the given distribution rendered another image";
+}
+
 }  // namespace
 }  // namespace pdflab

@@ -111,10 +111,6 @@ TEST_F(SweepCommand, BadTechniquesAreBadInput) {
   expect_bad_input(with({"--vary", "cosine,light", "--strategy", "uniform-sphere"}), "no weight");
   expect_bad_input(with({"--vary", "cosine,light", "--seeds", "0"}), "--seeds");
   expect_bad_input(with({"--vary", "cosine,light", "--seconds", "1"}), "exactly one");
-  // Path guiding is trained by each render: auto weight's passes of one film would each train anew.
-  expect_bad_input(with({"--vary", "cosine,guided", "--auto"}), "auto weight does not take a mixture with guided");
-  expect_bad_input(with({"--vary", "cosine,light", "--strategy", "mix:cosine=1,light=1,guided=1", "--auto"}),
-                   "--auto: auto weight does not take");
   // At weight 0 the mixture is `light` alone, and this scene has no importance targets.
   const std::string no_targets = in_work("no_targets.json");
   {
@@ -255,6 +251,28 @@ TEST_F(SweepCommand, AutoWeightAddsARow) {
   EXPECT_EQ(std::count(history.begin(), history.end(), '>'), 4) << "five passes";
   EXPECT_GT(number(rows[3], "efficiency"), 0.0);
   EXPECT_NE(r.out.find("auto weight: efficiency"), std::string::npos) << r.out;
+}
+
+// A cosine/guided pair: each weight's run trains its own tree; auto weight's
+// first pass trains and its later passes draw from that tree; the prediction
+// replays with the pilot's.
+TEST_F(SweepCommand, GuidedPairIsSweptAndAutoWeighted) {
+  make_reference();
+  const ChildResult r = run(
+      sweep_args({"--vary", "cosine,guided:2", "--weights", "0.25:0.75:0.5", "--spp", "16", "--seeds", "1", "--auto"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> header;
+  const auto rows = read_csv(slurp(in_work("out.csv")), header);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].at("strategy"), "mix:cosine=0.25,guided:2=0.75");
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_GT(number(rows[i], "efficiency"), 0.0) << i;
+    EXPECT_GT(number(rows[i], "predicted_efficiency"), 0.0) << i;
+  }
+  const std::string history = rows[2].at("strategy");
+  ASSERT_EQ(history.rfind("auto:0.5>", 0), 0u) << history;
+  EXPECT_EQ(std::count(history.begin(), history.end(), '>'), 4) << "five passes";
+  EXPECT_GT(number(rows[2], "efficiency"), 0.0);
 }
 
 }  // namespace

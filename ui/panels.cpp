@@ -203,21 +203,14 @@ void draw_weight_curve(ViewerSettings& settings, PanelState& state, const UiStat
   } else {
     ImGui::TextColored(kDim, "a sample costs: not priced yet");
   }
-  const bool guided = s.weights[static_cast<int>(Technique::Guided)] > 0.0f;
-  ImGui::BeginDisabled(depth_one || guided);
+  ImGui::BeginDisabled(depth_one);
   ImGui::Checkbox("Auto weight", &settings.auto_weight);
   ImGui::EndDisabled();
   layout::item("sampling.auto_weight");
-  const bool hovered = ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled);
-  if (guided) {
-    ImGui::SameLine();
-    one_line("not with guided", kDim);
-  }
-  if (hovered)
-    ImGui::SetTooltip(guided ? "Auto weight changes w between passes of one film; with guided each pass would train\n"
-                               "path guiding anew. The curve above predicts with the distribution this render learned."
-                             : "Between passes (at 16, 32, 64, ... spp) w moves to the best the passes so far predict;\n"
-                               "each pass's weight is fixed before it starts, so the accumulated image stays unbiased.");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Between passes (at 16, 32, 64, ... spp) w moves to the best the passes so far predict;\n"
+                      "each pass's weight is fixed before it starts, so the accumulated image stays unbiased.\n"
+                      "With guided, every pass draws from the distribution the first one learned.");
   if (settings.auto_weight) {
     // Its history's line and plot are there while auto weight is on, filled or not.
     ImGui::SameLine();

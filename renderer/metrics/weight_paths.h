@@ -38,14 +38,6 @@ struct TechniquePair {
   double weight_of(const Strategy& s) const;
 };
 
-// Why auto weight refuses a mixture with `guided`: its passes continue one
-// film at changing weights, and each would train a distribution of its own
-// (the prediction of a fixed render uses the one that render learned:
-// WeightPathOptions::guiding).
-inline constexpr const char* kGuidedNoAutoWeight =
-    "auto weight does not take a mixture with guided: each of its passes would train path guiding anew "
-    "(docs/guiding.md)";
-
 // "A,B" (a comma between two technique names) with an optional base mixture
 // whose other techniques keep their weights, and Russian roulette from
 // `roulette_depth` on (0: the base's own, if any). InputError naming `vary` or `base`.

@@ -110,13 +110,17 @@ void RenderSession::apply_settings_locked(RenderSettings settings, const Samplin
   next_sweep_spp_ = 0;
   // guided:PASSES trains anew for each generation (a resumed film too: the
   // training depends on the scene, the strategy and the seed alone, so it
-  // learns the distribution the film was rendered with).
+  // learns the distribution the film was rendered with), unless the settings
+  // give the distribution (auto weight's later passes).
   const int guided = static_cast<int>(Technique::Guided);
   training_passes_ = plan_.weight[guided] > 0.0f ? static_cast<int>(std::lround(plan_.parameter[guided])) : 0;
   training_done_ = 0;
   trainer_.reset();
   guide_.reset();
-  if (training_passes_ > 0) {
+  if (training_passes_ > 0 && settings_.guiding) {
+    training_passes_ = 0;  // given: drawn from as it is
+    guide_ = settings_.guiding;
+  } else if (training_passes_ > 0) {
     trainer_ = std::make_unique<GuidingTrainer>(*settings_.scene);
     guide_ = trainer_->distribution();
   }

@@ -34,6 +34,11 @@ struct RenderSettings {
   // Sample index of the film's first sample: renders of disjoint index ranges
   // of one seed (on several machines) merge into one render of their union.
   std::uint32_t first_sample = 0;
+  // Path guiding's distribution, given (a strategy with `guided`): drawn from
+  // as it is, no training passes. Auto weight's passes of one film keep the
+  // distribution its first pass learned, so every pass draws from one that
+  // was fixed before it started. Null: `guided:PASSES` trains its own.
+  std::shared_ptr<const GuidingDistribution> guiding;
 };
 
 // An accumulation to continue (a saved film): `spp` samples per pixel, indices
