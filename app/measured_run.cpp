@@ -46,7 +46,7 @@ MeasuredRun render_measured(const std::shared_ptr<const Scene>& scene, const Str
       break;
     }
   }
-  MeasuredRun run{session.copy_film(), {}, nullptr};  // waits for the pass in flight
+  MeasuredRun run{session.copy_film(), {}};  // waits for the pass in flight
   run.stats = session.stats();
   run.guiding = session.guiding();
   return run;

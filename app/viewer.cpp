@@ -1078,9 +1078,8 @@ void Viewer::Impl::fill_status() {
   status.max_depth = applied.max_depth;
   status.messages = messages();
   const ui::ViewMode mode = settings.measure.view_mode;
-  status.can_export_view = mode != ui::ViewMode::Image && mode != ui::ViewMode::Drops &&
-                           mode != ui::ViewMode::GuidingTree && measure.layer_ok &&
-                           measure.layer_mode == mode && !teaching->split_active();
+  status.can_export_view =
+      ui::view_mode_exports(mode) && measure.layer_ok && measure.layer_mode == mode && !teaching->split_active();
   status.can_export_curve = !status.weights.weight.empty() && status.weights.active;
   status.can_export_convergence = !measure.curves.live().points.empty() || !measure.curves.pins().empty();
 }
@@ -1156,8 +1155,7 @@ std::string saved_text(const std::string& what, const std::vector<std::string>& 
 // (what is shown, of which render, measured how).
 void Viewer::Impl::export_view() {
   const ui::ViewMode mode = settings.measure.view_mode;
-  if (mode == ui::ViewMode::Image || mode == ui::ViewMode::Drops || mode == ui::ViewMode::GuidingTree ||
-      !measure.layer_ok || measure.layer_mode != mode) {
+  if (!ui::view_mode_exports(mode) || !measure.layer_ok || measure.layer_mode != mode) {
     notice("Nothing to export: V picks a heat map, difference, best-weight or technique-share view to export.", true);
     return;
   }
@@ -1309,9 +1307,7 @@ void Viewer::Impl::service_guiding_tree() {
   leaf_map_guide = guide;
   leaf_map_scene = render_scene;
   if (!guide) {
-    ui::GuidingLeafMap map;
-    map.why = "render a strategy with guided (its training builds the tree), e.g. nee-mis+mix:cosine=0.5,guided=0.5";
-    measure.set_guiding_leaves(std::move(map));
+    measure.set_guiding_leaves(ui::GuidingLeafMap{});  // no map: the layer says why
     settle_frames = std::max(settle_frames, 1);
     return;
   }

@@ -37,6 +37,10 @@ ViewMode parse_view_mode(const std::string& name) {
                    "' is not a view mode (image, heatmap, difference, drops, best-weight, technique-share, guiding-tree)");
 }
 
+bool view_mode_exports(ViewMode mode) {
+  return mode != ViewMode::Image && mode != ViewMode::Drops && mode != ViewMode::GuidingTree;
+}
+
 ViewMode next_view_mode(ViewMode mode) {
   return static_cast<ViewMode>((static_cast<int>(mode) + 1) % kViewModeCount);
 }
@@ -286,22 +290,20 @@ bool build_weight_layer(ViewMode mode, const WeightMaps* maps, ViewLayer& out, s
 bool build_guiding_layer(const GuidingLeafMap* map, ViewLayer& out, std::string& why) {
   const std::size_t pixels = map ? static_cast<std::size_t>(map->width) * static_cast<std::size_t>(map->height) : 0;
   if (!map || pixels == 0 || map->leaf.size() != pixels) {
-    why = map && !map->why.empty() ? map->why : "render a strategy with guided (its training builds the tree)";
+    why = "render a strategy with guided (its training builds the tree), e.g. nee-mis+mix:cosine=0.5,guided=0.5";
     return false;
   }
   out.width = map->width;
   out.height = map->height;
   out.rgba.assign(4 * pixels, 0);
   out.drop_pixels = {};
-  const auto at = [&](int x, int y) {
-    return map->leaf[static_cast<std::size_t>(y) * static_cast<std::size_t>(map->width) + static_cast<std::size_t>(x)];
-  };
+  const auto row = static_cast<std::size_t>(map->width);
   for (int y = 0; y < map->height; ++y)
     for (int x = 0; x < map->width; ++x) {
-      const std::int32_t leaf = at(x, y);
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(map->width) + static_cast<std::size_t>(x);
+      const std::size_t p = static_cast<std::size_t>(y) * row + static_cast<std::size_t>(x);
+      const std::int32_t leaf = map->leaf[p];
       if (leaf < 0) continue;  // transparent: the image shows
-      const bool border = (x + 1 < map->width && at(x + 1, y) != leaf) || (y + 1 < map->height && at(x, y + 1) != leaf);
+      const bool border = (x + 1 < map->width && map->leaf[p + 1] != leaf) || (y + 1 < map->height && map->leaf[p + row] != leaf);
       if (border) put(out.rgba, p, {0.05f, 0.05f, 0.05f}, 230);
       else put(out.rgba, p, guiding_leaf_colour(leaf), 110);
     }

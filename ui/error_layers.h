@@ -25,6 +25,10 @@ enum class ViewMode : std::uint8_t {
 inline constexpr int kViewModeCount = static_cast<int>(ViewMode::Count);
 const char* view_mode_label(ViewMode mode);
 ViewMode next_view_mode(ViewMode mode);
+// Whether the view exports as a figure with a colour bar (Ctrl+E): the heat
+// map, the difference and the two weight views; not the image itself, nor the
+// views drawn over it (dropped samples, path guiding's tree).
+bool view_mode_exports(ViewMode mode);
 // A view mode by its short name (image, heatmap, difference, drops,
 // best-weight, technique-share, guiding-tree); InputError naming them otherwise.
 ViewMode parse_view_mode(const std::string& name);
@@ -112,7 +116,6 @@ ColourScale technique_share_scale(const WeightMaps& maps);
 // distribution): per pixel the S-tree leaf of the surface it sees
 // (guiding_leaf_map; -1: none).
 struct GuidingLeafMap {
-  std::string why;  // when there is none: why
   int width = 0, height = 0;
   std::vector<std::int32_t> leaf;
   int leaves = 0;     // in the whole tree

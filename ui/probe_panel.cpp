@@ -65,6 +65,11 @@ ProbeMap make_bsdf_map(const Scene& scene, const ProbePoint& at, int w, int h) {
 // mixture's broad cosine part shows beside its sharp light part. `scale_top`:
 // the value at the top of the colour scale (0: the map's own maximum), so
 // maps drawn side by side can share one scale.
+// A map value's place on the colour map: linear up to `top`, or four decades below it.
+float map_shade(double v, double top, bool log_scale) {
+  return static_cast<float>(log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top);
+}
+
 void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale, double scale_top = 0.0) {
   ImGui::TextUnformatted(map.title.c_str());
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
@@ -81,9 +86,8 @@ void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale, double scale_top
   for (int r = 0; r < map.height; ++r)
     for (int c = 0; c < map.width; ++c) {
       const double v = map.values[static_cast<std::size_t>(r) * map.width + c];
-      const double t = log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top;
       const float x = p0.x + cw * static_cast<float>(c), y = p0.y + ch * static_cast<float>(r);
-      list->AddRectFilled(ImVec2(x, y), ImVec2(x + cw + 0.5f, y + ch + 0.5f), draw::colormap(static_cast<float>(t)));
+      list->AddRectFilled(ImVec2(x, y), ImVec2(x + cw + 0.5f, y + ch + 0.5f), draw::colormap(map_shade(v, top, log_scale)));
     }
   // The horizon: above it the hemisphere of the surface, below it the directions into it.
   const float hy = p0.y + size.y * 0.5f;
@@ -114,10 +118,8 @@ void quadtree_view(const ProbeState& s, float side, bool log_scale, double top) 
   ImDrawList* list = ImGui::GetWindowDrawList();
   if (top <= 0.0) top = 1.0;
   for (const GuidingDistribution::Cell& c : s.guide_cells) {
-    const double v = c.pdf;
-    const double t = log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top;
     const ImVec2 a(p0.x + side * c.s, p0.y + side * c.t), b(p0.x + side * (c.s + c.size), p0.y + side * (c.t + c.size));
-    list->AddRectFilled(a, b, draw::colormap(static_cast<float>(t)));
+    list->AddRectFilled(a, b, draw::colormap(map_shade(c.pdf, top, log_scale)));
     const Vec3 d = direction_from_square(c.s + 0.5f * c.size, c.t + 0.5f * c.size);
     if (dot(d, s.point.normal) < 0.0f) list->AddRectFilled(a, b, IM_COL32(0, 0, 0, 140));
     if (b.x - a.x >= 3.0f) list->AddRect(a, b, IM_COL32(20, 20, 26, 200));
@@ -573,13 +575,10 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
       ImGui::EndGroup();
       ImGui::SameLine();
       ImGui::BeginGroup();
-      const Colour leaf_colour = guiding_leaf_colour(s.guide_leaf);
       const ImVec2 q = ImGui::GetCursorScreenPos();
       const float sw = ImGui::GetFontSize();
-      ImGui::GetWindowDrawList()->AddRectFilled(
-          ImVec2(q.x, q.y + 2.0f), ImVec2(q.x + sw, q.y + sw - 2.0f),
-          IM_COL32(static_cast<int>(leaf_colour[0] * 255.0f), static_cast<int>(leaf_colour[1] * 255.0f),
-                   static_cast<int>(leaf_colour[2] * 255.0f), 255));
+      ImGui::GetWindowDrawList()->AddRectFilled(ImVec2(q.x, q.y + 2.0f), ImVec2(q.x + sw, q.y + sw - 2.0f),
+                                                to_u32(guiding_leaf_colour(s.guide_leaf)));
       ImGui::Dummy(ImVec2(sw, sw));
       ImGui::SameLine();
       ImGui::Text("leaf %d of %d", s.guide_leaf, s.guide->leaves());
