@@ -128,6 +128,33 @@ TEST(GuidingTrainer, LearnsWhereTheLightComesFrom) {
   EXPECT_EQ(trainer.passes(), 3);
 }
 
+// A draw spends the 24 bits of a float down the quadtree, so a cell holding
+// less than about 2^-24 of a leaf's light could not be drawn as often as its
+// density says: a cell below kGuidingDrawableShare gets no density at all
+// (and so is never owed a draw), one above keeps its share.
+TEST(GuidingTrainer, CellsTooFaintToDrawGetNoDensity) {
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
+  const Vec3 bright = direction_from_square(0.2f, 0.2f);  // quadrant 0
+  const Vec3 faint = direction_from_square(0.8f, 0.2f);   // quadrant 1
+  const Vec3 dim = direction_from_square(0.2f, 0.8f);     // quadrant 2
+  const Vec3 at(0.5f), up(0.0f, 0.0f, 1.0f);
+  for (int i = 0; i < 1000; ++i) trainer.record(at, up, bright, 1.0e4);  // 10^7 in all
+  trainer.record(at, up, faint, 1.0);  // 10^-7 of the leaf: below 2^-16
+  trainer.record(at, up, dim, 1.0e4);  // 10^-3: above
+  trainer.finish_pass();
+  const GuidingDistribution& g = *trainer.distribution();
+  EXPECT_EQ(g.pdf(at, up, faint), 0.0f);
+  EXPECT_GT(g.pdf(at, up, dim), 0.0f);
+  // The density the faint cell gave up went to the others: it still integrates to one.
+  double integral = 0.0;
+  for (const GuidingDistribution::Cell& c : g.cells(g.leaf_at(at, up)))
+    integral += static_cast<double>(c.pdf) * c.size * c.size * 4.0 * kPi;
+  EXPECT_NEAR(integral, 1.0, 1e-6);
+  // The dim cell's share, 10^-3 / (1 + 10^-3) of the light, in its quadrant's density.
+  EXPECT_NEAR(g.pdf(at, up, dim) * kPi, 1.0e-3 / (1.0 + 1.0e-3), 1e-6);
+  expect_sampler_follows_density(g, at, 31);
+}
+
 // The probe's picture of a leaf's quadtree: its cells tile the map, each
 // carries the density the distribution gives its directions, and together
 // they integrate to one; a leaf's box holds the points that find it.

@@ -4,6 +4,7 @@
 #include "renderer/scene/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -30,6 +31,32 @@ void halves(const Vec3& lo, const Vec3& hi, int axis, float split, Vec3& below_h
   above_lo = lo;
   below_hi[axis] = split;
   above_lo[axis] = split;
+}
+
+// The energy of each quadrant of a leaf's collecting nodes that the next
+// distribution keeps. A draw consumes the 24 bits of a float in [0, 1) down
+// the tree, so a cell holding less than about 2^-24 of the leaf could not be
+// reached as often as its density says (not at all below 2^-24): cells under
+// kGuidingDrawableShare of the leaf's energy are given none, so that their
+// density is 0 where the draw cannot go, and every cell the density keeps is
+// drawn within about 2^-24 / kGuidingDrawableShare of its probability.
+std::vector<std::array<double, 4>> drawable_energy(const std::vector<GuidingTrainer::CollectNode>& nodes) {
+  std::vector<std::array<double, 4>> kept(nodes.size(), std::array<double, 4>{0.0, 0.0, 0.0, 0.0});
+  const double least = total_energy(nodes[0].energy) * kGuidingDrawableShare;
+  const std::function<double(std::size_t)> keep = [&](std::size_t node) {
+    double sum = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      const double e = static_cast<double>(nodes[node].energy[c]);
+      if (!(e >= least)) continue;
+      // An inner quadrant keeps what its cells keep.
+      const std::int32_t child = nodes[node].child[c];
+      kept[node][static_cast<std::size_t>(c)] = child ? keep(static_cast<std::size_t>(child)) : e;
+      sum += kept[node][static_cast<std::size_t>(c)];
+    }
+    return sum;
+  };
+  keep(0);
+  return kept;
 }
 
 }  // namespace
@@ -291,11 +318,14 @@ void GuidingTrainer::finish_pass() {
       next->nodes_.push_back(kUniformRoot);
       continue;
     }
-    for (const CollectNode& n : nodes) {
-      const double sum = total_energy(n.energy);
+    const std::vector<std::array<double, 4>> kept = drawable_energy(nodes);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const CollectNode& n = nodes[i];
+      const std::array<double, 4>& e = kept[i];
+      const double sum = e[0] + e[1] + e[2] + e[3];
       GuidingDistribution::QuadNode q{};
       for (int c = 0; c < 4; ++c) {
-        q.factor[c] = sum > 0.0 ? static_cast<float>(4.0 * static_cast<double>(n.energy[c]) / sum) : 1.0f;
+        q.factor[c] = sum > 0.0 ? static_cast<float>(4.0 * e[c] / sum) : 1.0f;
         q.child[c] = n.child[c] ? first + n.child[c] : 0;
       }
       q.derive();

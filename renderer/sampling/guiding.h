@@ -51,6 +51,7 @@ Vec3 direction_from_square(float s, float t);
 
 inline constexpr int kGuidingMaxDepth = 16;  // D-tree levels at most
 inline constexpr double kGuidingSplitShare = 0.01;  // a cell above this share of its leaf's energy is split
+inline constexpr double kGuidingDrawableShare = 0x1.0p-16;  // a cell below this share of its leaf's energy gets none
 inline constexpr double kGuidingSpatialThreshold = 16000.0;  // records before a leaf splits, times sqrt(2^pass)
 // The S-tree is six trees, one for the surfaces that face each way along each
 // axis (the normal's largest component and its sign): a floor and the wall
@@ -170,11 +171,13 @@ class GuidingTrainer {
   int passes() const { return passes_; }
   std::uint64_t records() const { return records_total_; }
 
- private:
+  // A node of a D-tree being recorded into: each quadrant's energy and child.
   struct CollectNode {
     std::uint64_t energy[4];
     std::int32_t child[4];
   };
+
+ private:
   struct Leaf {  // of current_'s S-tree, by its leaf number
     std::vector<CollectNode> nodes;
     std::uint64_t count = 0;
