@@ -344,6 +344,36 @@ TEST(GuidingSession, TrainsTheSameForAnyThreadCount) {
   EXPECT_TRUE(same_image(one.film, four.film)) << "1 and 4 threads gave different images";
 }
 
+// What the training passes record is the light a surface takes in, L cos:
+// under a sky of one radiance a floor's learned distribution is the cosine
+// lobe, three quarters of it within 60 degrees of the normal (a record of L
+// alone would learn the uniform hemisphere: half).
+TEST(GuidingSession, LearnsTheLightTimesTheCosine) {
+  RenderSettings settings;
+  auto sky = std::make_shared<Scene>(load_scene_text(
+      R"({"camera": {"width": 32, "height": 24, "lookfrom": [0, 3, 0.01], "lookat": [0, 0, 0], "vfov": 60,
+          "max_depth": 2, "background": [1, 1, 1]},
+        "materials": {"floor": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+        "objects": [{"type": "quad", "q": [-2, 0, -2], "u": [0, 0, 4], "v": [4, 0, 0], "material": "floor"}]})",
+      "sky"));
+  sky->prepare();
+  settings.scene = sky;
+  settings.strategy = Strategy::parse("mix:cosine=0.5,guided:4=0.5");
+  settings.seed = 3;
+  settings.target_spp = 1;
+  RenderSession session(2);
+  session.set_settings(settings);
+  ASSERT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
+  const std::shared_ptr<const GuidingDistribution> g = session.guiding();
+  ASSERT_NE(g, nullptr);
+  const Vec3 at(0.3f, 0.0f, -0.2f), up(0.0f, 1.0f, 0.0f);
+  Rng rng(4, 4);
+  constexpr int kDraws = 100000;
+  int steep = 0;
+  for (int i = 0; i < kDraws; ++i) steep += g->sample(at, up, rng.uniform(), rng.uniform()).direction.y > 0.5f;
+  EXPECT_NEAR(static_cast<double>(steep) / kDraws, 0.75, 0.04);
+}
+
 // Auto weight's later passes: a session given a distribution draws from it
 // as it is and trains nothing; given the one a trained session learned, it
 // renders that session's very image.

@@ -74,6 +74,28 @@ TEST(Probe, IncidentLightMapIsADensityBrightestTowardsTheLamp) {
   EXPECT_EQ(map, incident_light_map(s, at, kW, kH, 16, 5));
 }
 
+// Under a sky of one radiance everywhere, the light a floor takes in is
+// L cos: the map is the cosine lobe's density, cos(theta) / pi, row by row.
+TEST(Probe, IncidentLightMapIsWeightedByTheCosine) {
+  Scene s = load_scene_text(R"({"camera": {"width": 20, "height": 20, "lookfrom": [0, 3, 0.01], "lookat": [0, 0, 0],
+      "vfov": 30, "max_depth": 2, "background": [1, 1, 1]},
+    "materials": {"floor": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+    "objects": [{"type": "quad", "q": [-50, 0, -50], "u": [0, 0, 100], "v": [100, 0, 0], "material": "floor"}]})",
+                            "sky");
+  s.prepare();
+  const ProbePoint at = first_diffuse_hit(s, 10, 10);
+  ASSERT_TRUE(at.found);
+  constexpr int kW = 16, kH = 16;
+  const std::vector<float> map = incident_light_map(s, at, kW, kH, 64, 3);
+  for (int row = 0; row < kH / 2; ++row) {
+    // A cell's mean of cos / pi: z runs from 1 - 2 row / kH to 1 - 2 (row + 1) / kH.
+    const double z = 1.0 - (2.0 * row + 1.0) / kH;
+    double mean = 0.0;
+    for (int col = 0; col < kW; ++col) mean += map[static_cast<std::size_t>(row * kW + col)] / kW;
+    EXPECT_NEAR(mean, z / 3.141592653589793, 0.01) << "row " << row;
+  }
+}
+
 TEST(Probe, DirectionsComeFromTheTechniquesInProportionToTheirWeights) {
   const Scene s = book();
   const SamplingPlan plan = SamplingPlan::make(Strategy::parse("mix:cosine=0.25,light=0.75"), s);

@@ -208,7 +208,7 @@ std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, 
           const float phi = 2.0f * kPi * (static_cast<float>(col) + (static_cast<float>(b) + rng.uniform()) / fk) /
                             static_cast<float>(width);
           const Vec3 light = trace_path(scene, plan, Ray{at.point, f.direction(z, phi)}, rng, drops);
-          sum += luminance(light.x, light.y, light.z);
+          sum += luminance(light.x, light.y, light.z) * z;  // times the cosine: what guiding learns
         }
       const double mean = sum / (k * k);
       out[static_cast<std::size_t>(row) * width + col] = static_cast<float>(mean);

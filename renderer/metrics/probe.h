@@ -59,9 +59,10 @@ std::vector<float> bsdf_pdf_map(const Scene& scene, const ProbePoint& at, int wi
 // density in pdf_map's layout: in each cell above the surface, `per_cell`
 // paths of nee-mis (the scene's plain estimator; cosine where it has no
 // lights) leave the point along directions spread evenly over the cell, and
-// their luminances are averaged; the map is then divided by its integral over
-// the sphere, so it is the incident light's own distribution L(w) / (integral
-// of L) — what path guiding learns to draw from. Cells below the surface: 0.
+// their luminances times the cosine to the normal are averaged; the map is
+// then divided by its integral over the sphere, so it is the distribution of
+// the light the surface takes in, L(w) cos / (integral of L cos) — what path
+// guiding learns to draw from. Cells below the surface: 0.
 // All zeros where no light arrives. Deterministic for a seed.
 std::vector<float> incident_light_map(const Scene& scene, const ProbePoint& at, int width, int height, int per_cell,
                                       std::uint64_t seed);

@@ -19,8 +19,10 @@
 //
 // Learning (GuidingTrainer) runs in passes: a pass renders with the current
 // distribution and records at each diffuse vertex the radiance that arrived
-// along the drawn direction, divided by that direction's density (each
-// record an estimate of the light in its cell). Then each S-tree leaf that
+// along the drawn direction times its cosine to the normal, divided by that
+// direction's density (each record an estimate of the light the surface
+// takes in through its cell: the cosine is the diffuse BRDF's share of the
+// product f L cos that a continuation's weight divides by its density). Then each S-tree leaf that
 // took more than kSpatialThreshold sqrt(2^pass) records splits in half across
 // its longest side (both halves keep its D-tree); each leaf's recorded
 // energies become its next distribution; and the D-trees the next pass
