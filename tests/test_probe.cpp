@@ -42,7 +42,7 @@ TEST(Probe, FindsTheFirstDiffuseSurface) {
   EXPECT_GE(through_glass.specular_bounces, 1);
 }
 
-// The incident light traced by brute force (what path guiding learns): a
+// The light taken in, L cos, traced by brute force (what path guiding learns): a
 // density over the sphere, zero below the surface, brightest towards the lamp
 // from the book's floor, and the same for the same seed.
 TEST(Probe, IncidentLightMapIsADensityBrightestTowardsTheLamp) {

@@ -453,7 +453,7 @@ void poll_probe_incident(ProbeState& s) {
   if (!s.incident_job.valid() || s.incident_job.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
   std::vector<float> values = s.incident_job.get();
   if (s.incident_serial != s.serial) return;
-  s.incident_map.title = "the light arriving here, traced by brute force";
+  s.incident_map.title = "the light taken in here (L cos), traced by brute force";
   s.incident_map.width = kMapWidth;
   s.incident_map.height = kMapHeight;
   for (float v : values) s.incident_map.max_value = std::max(s.incident_map.max_value, v);
@@ -554,8 +554,8 @@ void draw_probe_panel(ProbeState& s, double now, float area_width, float area_he
   ImGui::TextWrapped("bsdf here: %s", s.bsdf_lobe.c_str());
   if (!s.guided_map.values.empty()) {
     // Path guiding's distribution at this point's leaf, as the render draws from it.
-    // Beside it the light that arrives here, traced by brute force: what the
-    // learning aims at, on one colour scale.
+    // Beside it the light taken in here (L cos), traced by brute force: what
+    // the learning aims at, on one colour scale.
     const double guided_top = std::max(s.guided_map.max_value, s.incident_map.max_value);
     ImGui::BeginGroup();
     draw_map(s.guided_map, ImVec2(map_h * 2.0f, map_h), s.log_scale, guided_top);

@@ -72,7 +72,7 @@ struct ProbeState {
   // `guided` alone as the render's distribution has learned it here (empty:
   // the strategy has no trained `guided`).
   ProbeMap guided_map;
-  // Beside it, the light arriving here traced by brute force
+  // Beside it, the light taken in here (L cos) traced by brute force
   // (incident_light_map), made in the background: what it should learn.
   ProbeMap incident_map;
   std::future<std::vector<float>> incident_job;

@@ -11,10 +11,11 @@
 #   PROBE_WAIT=20 PROBE_SCENE=assets/scenes/many_lights.json PROBE_STRATEGY=nee-mis+lights:tree \
 #   PROBE_OUT=docs/probe_many_lights.png tests/gui/capture_probe_docs.sh "" 8 50 80
 # docs/probe_guided.png (docs/guiding.md) is
-#   PROBE_WAIT=8 PROBE_SCROLL=10 PROBE_SCENE=assets/scenes/door_ajar.json \
+#   PROBE_WAIT=8 PROBE_SCROLL=6 PROBE_SCENE=assets/scenes/door_ajar.json \
 #   PROBE_STRATEGY="nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10" PROBE_OUT=docs/probe_guided.png \
 #   tests/gui/capture_probe_docs.sh "" 25 35 88
-# (probe_guided_partition.png at 50 8, probe_guided_wall.png at 75 45)
+# (probe_guided_partition.png at 50 8 and probe_guided_wall.png at 75 45 with
+# PROBE_SCROLL=10, probe_guided_tree.png at 35 88 with PROBE_SCROLL=16)
 # and docs/probe_light_choice.png (the README's starved box) is
 #   PROBE_WAIT=8 PROBE_SCENE=assets/scenes/starved_light.json PROBE_STRATEGY=nee-mis \
 #   PROBE_OUT=docs/probe_light_choice.png tests/gui/capture_probe_docs.sh "" 10 30 88
