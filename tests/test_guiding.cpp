@@ -128,6 +128,31 @@ TEST(GuidingTrainer, LearnsWhereTheLightComesFrom) {
   EXPECT_EQ(trainer.passes(), 3);
 }
 
+// The units records are counted in follow the light the paths bring back:
+// a first scale a billion times too coarse (a scene whose brightest light
+// is not what lights it) loses the first pass's records, and the next
+// passes, counted from the pass before's largest record, learn as any: after
+// two more, as much of the cone as a trainer counting well from the start
+// learns in two (GuidingTrainer.LearnsWhereTheLightComesFrom).
+TEST(GuidingTrainer, CountsInUnitsOfTheLightItRecords) {
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1e-9);
+  const Vec3 towards = normalize(Vec3(-0.4f, 0.2f, 0.7f));
+  teach(trainer, towards, 12.0, 200.0, 200000, 41);
+  EXPECT_EQ(trainer.distribution()->stats().nodes, static_cast<std::size_t>(trainer.distribution()->leaves()))
+      << "the first pass should have learned nothing: every leaf the uniform sphere";
+  teach(trainer, towards, 12.0, 200.0, 200000, 42);
+  teach(trainer, towards, 12.0, 200.0, 200000, 43);
+  const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+  const double c = std::cos(12.0 * kPi / 180.0);
+  const double share = 200.0 * (1.0 - c) / (200.0 * (1.0 - c) + (1.0 + c));
+  Rng rng(5, 5);
+  int inside = 0;
+  constexpr int kDraws = 100000;
+  for (int i = 0; i < kDraws; ++i)
+    inside += dot(g->sample(Vec3(0.5f), Vec3(0.0f, 0.0f, 1.0f), rng.uniform(), rng.uniform()).direction, towards) >= c;
+  EXPECT_NEAR(static_cast<double>(inside) / kDraws, share, 0.25 * share);
+}
+
 // A draw spends the 24 bits of a float down the quadtree, so a cell holding
 // less than about 2^-24 of a leaf's light could not be drawn as often as its
 // density says: a cell below kGuidingDrawableShare gets no density at all

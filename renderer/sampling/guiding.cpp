@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 
@@ -16,6 +17,12 @@ namespace {
 // A record's units at most: 2^24 of the brightest emission's, so 2^24 records
 // of that size still fit a slot.
 constexpr double kMostUnits = 0x1.0p40;
+// After the first pass the scale puts the largest record of the pass before
+// at 2^36 units: records down to 2^-36 of it count, and 2^28 of that size
+// still fit a slot. (The brightest emission alone misjudges a scene whose
+// brightest light is not what lights it: the box beside a beacon 10^9 times
+// brighter took records of under one unit, and learned nothing.)
+constexpr double kLargestUnits = 0x1.0p36;
 
 const GuidingDistribution::QuadNode kUniformRoot{{1.0f, 1.0f, 1.0f, 1.0f}, {0, 0, 0, 0}, 0.5f, {0.5f, 0.5f}};
 
@@ -226,6 +233,15 @@ void GuidingTrainer::record(const Vec3& point, const Vec3& normal, const Vec3& d
   Leaf& leaf = leaves_[static_cast<std::size_t>(current_->leaf_at(point, normal))];
   std::atomic_ref<std::uint64_t>(leaf.count).fetch_add(1, std::memory_order_relaxed);
   if (!(energy > 0.0)) return;  // no light (or not a number): counted, nothing added
+  // The pass's largest finite record: a positive double's bits order as it
+  // does, and the largest of a set is the same whatever order it arrives in.
+  std::uint64_t bits;
+  std::memcpy(&bits, &energy, sizeof bits);
+  std::atomic_ref<std::uint64_t> largest(largest_bits_);
+  for (std::uint64_t seen = largest.load(std::memory_order_relaxed);
+       std::isfinite(energy) && bits > seen &&
+       !largest.compare_exchange_weak(seen, bits, std::memory_order_relaxed);) {
+  }
   const double units = std::min(std::floor(energy * scale_ + 0.5), kMostUnits);
   if (units >= 1.0) collect(leaf, square_from_direction(direction), static_cast<std::uint64_t>(units));
 }
@@ -372,6 +388,12 @@ void GuidingTrainer::finish_pass() {
     leaf.nodes = std::move(refined);
     leaf.count = 0;
   }
+
+  // The next pass's units, from this one's largest record.
+  double largest;
+  std::memcpy(&largest, &largest_bits_, sizeof largest);
+  if (largest > 0.0 && std::isfinite(largest)) scale_ = kLargestUnits / largest;
+  largest_bits_ = 0;
 
   leaves_ = std::move(leaves);
   current_ = std::move(next);

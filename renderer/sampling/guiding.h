@@ -155,8 +155,10 @@ class GuidingDistribution {
 // Learns a GuidingDistribution pass by pass (see the top of this file).
 class GuidingTrainer {
  public:
-  // Over the scene's objects' box; `scale`: records are kept as integers in
-  // units of 1 / scale (the scene's brightest emission over 2^24 by default).
+  // Over the scene's objects' box; `scale`: the first pass's records are kept
+  // as integers in units of 1 / scale (the scene's brightest emission over
+  // 2^24 by default); each later pass's in units that put the largest record
+  // of the pass before at 2^36.
   explicit GuidingTrainer(const Scene& scene);
   GuidingTrainer(const Vec3& lo, const Vec3& hi, double scale);
   ~GuidingTrainer();
@@ -186,7 +188,8 @@ class GuidingTrainer {
   };
   void collect(Leaf& leaf, const SquarePoint& p, std::uint64_t units);
 
-  double scale_ = 1.0;
+  double scale_ = 1.0;  // units a record's energy is counted in: 1 / scale_
+  std::uint64_t largest_bits_ = 0;  // the pass's largest record (a double's bits)
   int passes_ = 0;
   std::uint64_t records_total_ = 0;
   std::vector<Leaf> leaves_;
