@@ -22,13 +22,15 @@
 // along the drawn direction times its cosine to the normal, divided by that
 // direction's density (each record an estimate of the light the surface
 // takes in through its cell: the cosine is the diffuse BRDF's share of the
-// product f L cos that a continuation's weight divides by its density). Then each S-tree leaf that
-// took more than kSpatialThreshold sqrt(2^pass) records splits in half across
-// its longest side (both halves keep its D-tree); each leaf's recorded
-// energies become its next distribution; and the D-trees the next pass
-// records into are refined from them: a cell holding more than kSplitShare of
-// its leaf's energy is split, finer cells holding less are merged, down to
-// kMaxDepth levels. Records are added as integers (fixed point), so a pass's
+// product f L cos that a continuation's weight divides by its density).
+// Then each S-tree leaf that took more than kSpatialThreshold sqrt(2^pass)
+// records splits in half across its longest side (both halves keep its
+// D-tree); each leaf's recorded energies become its next distribution (cells
+// under kDrawableShare of the leaf's given none); and the D-trees the next
+// pass records into are refined from them: a cell holding more than
+// kSplitShare of its leaf's energy is split, finer cells holding less are
+// merged, down to kMaxDepth levels. Records are added as integers (fixed
+// point, in units set from the pass before's largest record), so a pass's
 // sums, and with them every tree, are the same for any thread count and any
 // order of the records.
 #include "renderer/math.h"
