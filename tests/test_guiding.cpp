@@ -369,6 +369,12 @@ TEST(GuidingSession, TrainsTheSameForAnyThreadCount) {
   EXPECT_TRUE(same_image(one.film, four.film)) << "1 and 4 threads gave different images";
 }
 
+// Runs `session` on `settings` to its end (it renders with two workers).
+void run_to_end(RenderSession& session, const RenderSettings& settings) {
+  session.set_settings(settings);
+  ASSERT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
+}
+
 // What the training passes record is the light a surface takes in, L cos:
 // under a sky of one radiance a floor's learned distribution is the cosine
 // lobe, three quarters of it within 60 degrees of the normal (a record of L
@@ -387,8 +393,7 @@ TEST(GuidingSession, LearnsTheLightTimesTheCosine) {
   settings.seed = 3;
   settings.target_spp = 1;
   RenderSession session(2);
-  session.set_settings(settings);
-  ASSERT_TRUE(session.wait_until_done(std::chrono::seconds(300)));
+  run_to_end(session, settings);
   const std::shared_ptr<const GuidingDistribution> g = session.guiding();
   ASSERT_NE(g, nullptr);
   const Vec3 at(0.3f, 0.0f, -0.2f), up(0.0f, 1.0f, 0.0f);
@@ -409,14 +414,12 @@ TEST(GuidingSession, AGivenDistributionIsDrawnFromAsItIs) {
   settings.seed = 5;
   settings.target_spp = 4;
   RenderSession trained(2);
-  trained.set_settings(settings);
-  ASSERT_TRUE(trained.wait_until_done(std::chrono::seconds(300)));
+  run_to_end(trained, settings);
   EXPECT_EQ(trained.stats().guiding_passes, 3);
   settings.guiding = trained.guiding();
   ASSERT_NE(settings.guiding, nullptr);
   RenderSession given(2);
-  given.set_settings(settings);
-  ASSERT_TRUE(given.wait_until_done(std::chrono::seconds(300)));
+  run_to_end(given, settings);
   EXPECT_EQ(given.stats().guiding_passes, 0);
   EXPECT_EQ(given.stats().guiding_records, 0u);
   EXPECT_EQ(given.guiding(), settings.guiding);
