@@ -381,14 +381,7 @@ void run_to_end(RenderSession& session, const RenderSettings& settings) {
 // alone would learn the uniform hemisphere: half).
 TEST(GuidingSession, LearnsTheLightTimesTheCosine) {
   RenderSettings settings;
-  auto sky = std::make_shared<Scene>(load_scene_text(
-      R"({"camera": {"width": 32, "height": 24, "lookfrom": [0, 3, 0.01], "lookat": [0, 0, 0], "vfov": 60,
-          "max_depth": 2, "background": [1, 1, 1]},
-        "materials": {"floor": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
-        "objects": [{"type": "quad", "q": [-2, 0, -2], "u": [0, 0, 4], "v": [4, 0, 0], "material": "floor"}]})",
-      "sky"));
-  sky->prepare();
-  settings.scene = sky;
+  settings.scene = testing::sky_floor(32, 24);
   settings.strategy = Strategy::parse("mix:cosine=0.5,guided:4=0.5");
   settings.seed = 3;
   settings.target_spp = 1;

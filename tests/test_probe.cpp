@@ -5,6 +5,7 @@
 // book's scene (and fails when the pdf it is handed is wrong).
 #include "renderer/metrics/probe.h"
 #include "renderer/scene/scene_loader.h"
+#include "tests/render_support.h"
 
 #include <gtest/gtest.h>
 
@@ -77,12 +78,7 @@ TEST(Probe, IncidentLightMapIsADensityBrightestTowardsTheLamp) {
 // Under a sky of one radiance everywhere, the light a floor takes in is
 // L cos: the map is the cosine lobe's density, cos(theta) / pi, row by row.
 TEST(Probe, IncidentLightMapIsWeightedByTheCosine) {
-  Scene s = load_scene_text(R"({"camera": {"width": 20, "height": 20, "lookfrom": [0, 3, 0.01], "lookat": [0, 0, 0],
-      "vfov": 30, "max_depth": 2, "background": [1, 1, 1]},
-    "materials": {"floor": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
-    "objects": [{"type": "quad", "q": [-50, 0, -50], "u": [0, 0, 100], "v": [100, 0, 0], "material": "floor"}]})",
-                            "sky");
-  s.prepare();
+  const Scene s = *testing::sky_floor(20, 20);
   const ProbePoint at = first_diffuse_hit(s, 10, 10);
   ASSERT_TRUE(at.found);
   constexpr int kW = 16, kH = 16;

@@ -26,7 +26,6 @@ constexpr ImU32 kPinColours[] = {IM_COL32(90, 170, 255, 255),  IM_COL32(255, 140
                                  IM_COL32(240, 220, 80, 255),  IM_COL32(150, 120, 255, 255)};
 constexpr ImU32 kLiveColour = IM_COL32(255, 255, 255, 255);
 
-
 void text_row(const char* label, const char* tooltip, const std::string& value, const ImVec4* colour = nullptr) {
   ImGui::TableNextColumn();
   ImGui::TextColored(kDim, "%s", label);

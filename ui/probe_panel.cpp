@@ -61,15 +61,15 @@ ProbeMap make_bsdf_map(const Scene& scene, const ProbePoint& at, int w, int h) {
                      [&] { return bsdf_pdf_map(scene, at, w, h, kSupersample); });
 }
 
-// The map as coloured cells. Log scale: four decades below the maximum, so a
-// mixture's broad cosine part shows beside its sharp light part. `scale_top`:
-// the value at the top of the colour scale (0: the map's own maximum), so
-// maps drawn side by side can share one scale.
 // A map value's place on the colour map: linear up to `top`, or four decades below it.
 float map_shade(double v, double top, bool log_scale) {
   return static_cast<float>(log_scale ? (v > 0.0 ? 1.0 + std::log10(v / top) / 4.0 : 0.0) : v / top);
 }
 
+// The map as coloured cells. Log scale: four decades below the maximum, so a
+// mixture's broad cosine part shows beside its sharp light part. `scale_top`:
+// the value at the top of the colour scale (0: the map's own maximum), so
+// maps drawn side by side can share one scale.
 void draw_map(const ProbeMap& map, ImVec2 size, bool log_scale, double scale_top = 0.0) {
   ImGui::TextUnformatted(map.title.c_str());
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
