@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -23,6 +24,9 @@ constexpr double kMostUnits = 0x1.0p40;
 // brightest light is not what lights it: the box beside a beacon 10^9 times
 // brighter took records of under one unit, and learned nothing.)
 constexpr double kLargestUnits = 0x1.0p36;
+
+// leaf::guide_learned_light reads the root's row at float 11.
+static_assert(offsetof(GuidingDistribution::QuadNode, light) == 11 * sizeof(float));
 
 const GuidingDistribution::QuadNode kUniformRoot{{1.0f, 1.0f, 1.0f, 1.0f}, {0, 0, 0, 0}, 0.5f, {0.5f, 0.5f}};
 
@@ -281,8 +285,9 @@ void GuidingTrainer::finish_pass() {
   const double threshold = kGuidingSpatialThreshold * std::sqrt(std::ldexp(1.0, passes_));
   std::vector<GuidingDistribution::SpatialNode> spatial(static_cast<std::size_t>(kGuidingNormalBins));
   std::vector<Leaf> leaves;
-  const std::function<void(std::size_t, const Leaf&, std::uint64_t, Vec3, Vec3, int)> place =
-      [&](std::size_t at, const Leaf& leaf, std::uint64_t count, Vec3 lo, Vec3 hi, int depth) {
+  std::vector<float> light;  // per new leaf, its old leaf's mean record (-1: none)
+  const std::function<void(std::size_t, const Leaf&, std::uint64_t, float, Vec3, Vec3, int)> place =
+      [&](std::size_t at, const Leaf& leaf, std::uint64_t count, float mean, Vec3 lo, Vec3 hi, int depth) {
         const Vec3 size = hi - lo;
         const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
         if (static_cast<double>(count) > threshold && depth < 40) {
@@ -293,21 +298,26 @@ void GuidingTrainer::finish_pass() {
             spatial.resize(spatial.size() + 2);
             Vec3 mid_hi, mid_lo;
             halves(lo, hi, axis, split, mid_hi, mid_lo);
-            place(static_cast<std::size_t>(child), leaf, count / 2, lo, mid_hi, depth + 1);
-            place(static_cast<std::size_t>(child) + 1, leaf, count - count / 2, mid_lo, hi, depth + 1);
+            place(static_cast<std::size_t>(child), leaf, count / 2, mean, lo, mid_hi, depth + 1);
+            place(static_cast<std::size_t>(child) + 1, leaf, count - count / 2, mean, mid_lo, hi, depth + 1);
             return;
           }
         }
         spatial[at] = {-1, 0.0f, 0, static_cast<std::int32_t>(leaves.size())};
         leaves.push_back(leaf);
         leaves.back().count = count;
+        light.push_back(mean);
       };
   const std::function<void(std::size_t, std::size_t, Vec3, Vec3, int)> rebuild = [&](std::size_t old, std::size_t at,
                                                                                       Vec3 lo, Vec3 hi, int depth) {
     const GuidingDistribution::SpatialNode& n = current_->spatial_[old];
     if (n.axis < 0) {
       const Leaf& leaf = leaves_[static_cast<std::size_t>(n.leaf)];
-      place(at, leaf, leaf.count, lo, hi, depth);
+      // The mean record: the sum of the units over their number, in radiance.
+      const float mean =
+          leaf.count > 0 ? static_cast<float>(total_energy(leaf.nodes[0].energy) / scale_ / static_cast<double>(leaf.count))
+                         : -1.0f;
+      place(at, leaf, leaf.count, mean, lo, hi, depth);
       return;
     }
     const auto child = static_cast<std::int32_t>(spatial.size());
@@ -332,6 +342,7 @@ void GuidingTrainer::finish_pass() {
     next->roots_[k] = first;
     if (total_energy(nodes[0].energy) == 0.0) {
       next->nodes_.push_back(kUniformRoot);
+      next->nodes_.back().light = light[k];
       continue;
     }
     const std::vector<std::array<double, 4>> kept = drawable_energy(nodes);
@@ -345,6 +356,7 @@ void GuidingTrainer::finish_pass() {
         q.child[c] = n.child[c] ? first + n.child[c] : 0;
       }
       q.derive();
+      if (i == 0) q.light = light[k];
       next->nodes_.push_back(q);
     }
   }

@@ -81,7 +81,13 @@ class GuidingDistribution {
     std::int32_t child[4];
     float left;
     float low[2];
-    float unused[5] = {};  // kept zero, so that trees compare byte by byte
+    // In a D-tree's root: the mean of the records its leaf took in the pass
+    // it was learned from (an estimate of the light a surface there takes
+    // in, the integral of L cos over the sphere), -1 where it took none
+    // (untrained) and in every other node. The roulette by the learned light
+    // reads it (leaf::guide_learned_light).
+    float light = -1.0f;
+    float unused[4] = {};  // kept zero, so that trees compare byte by byte
     // The fields after factor, from it.
     void derive();
   };
