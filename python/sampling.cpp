@@ -120,6 +120,7 @@ void bind_sampling(py::module_& m) {
         d["nee_mis"] = s.nee_mis;
         d["sobol"] = s.sobol;
         d["roulette_depth"] = s.roulette_depth;
+        d["guided_roulette"] = s.guided_roulette;
         py::dict weights;
         for (const auto& [name, w] : mixture_terms(s)) weights[py::str(name)] = w;
         d["weights"] = weights;

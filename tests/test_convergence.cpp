@@ -82,6 +82,7 @@ const std::vector<StrategyRun>& unbiased_strategies() {
       {"mix:cosine=0.5,light-sa=0.5+sobol+rr", 512},
       // nee-mis continued by path guiding, trained in four passes before the render.
       {"nee-mis+mix:cosine=0.5,guided:4=0.5", 256},
+      {"nee-mis+mix:cosine=0.5,guided:4=0.5+rr:guided:2", 256},
   };
   // And every technique of the table alone (where unbiased) and mixed with
   // cosine (tests/table_strategies.h); alone, a technique gets the uniform
@@ -376,11 +377,13 @@ TEST(Convergence, MaxDepthMeansTheSameForEveryStrategy) {
 
 // Path guiding on the scene made for it (door_ajar.json, 24x24, paths of at
 // most 12 segments): the guided mixtures, trained as the session trains them
-// (four passes), converge to the image `fastest` gives. The light reaches the
+// (four passes), with the throughput's roulette or the learned light's
+// (+rr:guided), converge to the image `fastest` gives. The light reaches the
 // near room only through the gap, so these are the paths the guided half aims at.
 TEST(Convergence, GuidedMixturesAgreeOnTheDoorScene) {
   const char* strategies[] = {"mix:cosine=0.5,guided:4=0.5+rr:6", "nee-mis+mix:cosine=0.5,guided:4=0.5+rr:6",
-                              "nee-mis+mix:cosine=0.7,guided:6=0.3"};
+                              "nee-mis+mix:cosine=0.7,guided:6=0.3", "nee-mis+mix:cosine=0.5,guided:4=0.5+rr:guided",
+                              "mix:cosine=0.5,guided:4=0.5+rr:guided:3"};
   constexpr int kSmall = 24;
   const int tests = static_cast<int>(std::size(strategies)) * (kSmall / kBlock) * (kSmall / kBlock) * 3;
   const double limit = stats::normal_two_sided_quantile(stats::sidak_alpha(kFamilyAlpha, tests));

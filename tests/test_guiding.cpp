@@ -183,6 +183,40 @@ TEST(GuidingTrainer, CellsTooFaintToDrawGetNoDensity) {
 // The probe's picture of a leaf's quadtree: its cells tile the map, each
 // carries the density the distribution gives its directions, and together
 // they integrate to one; a leaf's box holds the points that find it.
+// Each D-tree's root carries its leaf's mean record, the zero records
+// counted (+rr:guided reads it as the light a surface there takes in); a
+// leaf that took no record, and the untrained sphere, carry -1.
+TEST(GuidingTrainer, EachLeafKnowsItsMeanRecord) {
+  GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
+  {
+    const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+    EXPECT_EQ(g->node(g->root(g->leaf_at(Vec3(0.5f), Vec3(0.0f, 0.0f, 1.0f)))).light, -1.0f);
+  }
+  // Under +z: one record in four brings 6 (in 1/1024 units: exact), the rest
+  // nothing, so the mean is 1.5; along +x: every record 0.25.
+  Rng rng(8, 8);
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p(rng.uniform(), rng.uniform(), rng.uniform());
+    const Vec3 d = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, 1.0f));
+    trainer.record(p, Vec3(0.0f, 0.0f, 1.0f), d, i % 4 == 0 ? 6.0 : 0.0);
+    trainer.record(p, Vec3(1.0f, 0.0f, 0.0f), d, 0.25);
+  }
+  trainer.finish_pass();
+  const std::shared_ptr<const GuidingDistribution> g = trainer.distribution();
+  const auto light = [&](const Vec3& normal) { return g->node(g->root(g->leaf_at(Vec3(0.5f), normal))).light; };
+  EXPECT_FLOAT_EQ(light(Vec3(0.0f, 0.0f, 1.0f)), 1.5f);
+  EXPECT_FLOAT_EQ(light(Vec3(1.0f, 0.0f, 0.0f)), 0.25f);
+  EXPECT_EQ(light(Vec3(0.0f, 1.0f, 0.0f)), -1.0f) << "a leaf without records";
+  // Not in any other node.
+  for (std::size_t i = 0; i < g->nodes().size(); ++i) {
+    bool is_root = false;
+    for (int leaf = 0; leaf < g->leaves(); ++leaf) is_root = is_root || g->root(leaf) == static_cast<std::int32_t>(i);
+    if (!is_root) {
+      EXPECT_EQ(g->nodes()[i].light, -1.0f) << "node " << i;
+    }
+  }
+}
+
 TEST(GuidingDistribution, CellsAndBoxesDescribeTheTrees) {
   GuidingTrainer trainer(Vec3(0.0f), Vec3(1.0f), 1024.0);
   const Vec3 towards = normalize(Vec3(-0.4f, 0.2f, 0.9f));
@@ -348,25 +382,43 @@ bool same_image(const Film& a, const Film& b) {
 }
 
 // The training passes record through the packet tracer from every worker at
-// once; the trees, and so the image, are the same for 1, 2 and 4 threads.
+// once; the trees, and so the image, are the same for 1, 2 and 4 threads, with
+// the roulette by the learned light too (which reads them).
 TEST(GuidingSession, TrainsTheSameForAnyThreadCount) {
   const auto scene = small_door(40, 30);
-  const std::string strategy = "nee-mis+mix:cosine=0.5,guided:4=0.5";
-  const testing::Rendered one = testing::render_to_completion(scene, strategy, 4, 5, 1, std::chrono::seconds(300));
-  const testing::Rendered two = testing::render_to_completion(scene, strategy, 4, 5, 2, std::chrono::seconds(300));
-  // More workers than this machine may have cores: the blocks interleave differently again.
-  const testing::Rendered four = testing::render_to_completion(scene, strategy, 4, 5, 4, std::chrono::seconds(300));
-  EXPECT_EQ(one.stats.guiding_pass, 4);
-  EXPECT_EQ(one.stats.guiding_passes, 4);
-  EXPECT_GT(one.stats.guiding.nodes, 1u);
-  EXPECT_GT(one.stats.guiding_records, 40u * 30u * 15u);  // at least one vertex for each of 15 samples a pixel
-  EXPECT_EQ(one.stats.guiding.nodes, two.stats.guiding.nodes);
-  EXPECT_EQ(one.stats.guiding_records, two.stats.guiding_records);
-  EXPECT_EQ(one.stats.guiding.nodes, four.stats.guiding.nodes);
-  EXPECT_EQ(one.stats.guiding_records, four.stats.guiding_records);
-  EXPECT_EQ(one.stats.spp, 4u);
-  EXPECT_TRUE(same_image(one.film, two.film)) << "1 and 2 threads gave different images";
-  EXPECT_TRUE(same_image(one.film, four.film)) << "1 and 4 threads gave different images";
+  for (const char* strategy : {"nee-mis+mix:cosine=0.5,guided:4=0.5", "mix:cosine=0.5,guided:4=0.5+rr:guided:3"}) {
+    SCOPED_TRACE(strategy);
+    const testing::Rendered one = testing::render_to_completion(scene, strategy, 4, 5, 1, std::chrono::seconds(300));
+    const testing::Rendered two = testing::render_to_completion(scene, strategy, 4, 5, 2, std::chrono::seconds(300));
+    // More workers than this machine may have cores: the blocks interleave differently again.
+    const testing::Rendered four = testing::render_to_completion(scene, strategy, 4, 5, 4, std::chrono::seconds(300));
+    EXPECT_EQ(one.stats.guiding_pass, 4);
+    EXPECT_EQ(one.stats.guiding_passes, 4);
+    EXPECT_GT(one.stats.guiding.nodes, 1u);
+    EXPECT_GT(one.stats.guiding_records, 40u * 30u * 15u);  // at least one vertex for each of 15 samples a pixel
+    EXPECT_EQ(one.stats.guiding.nodes, two.stats.guiding.nodes);
+    EXPECT_EQ(one.stats.guiding_records, two.stats.guiding_records);
+    EXPECT_EQ(one.stats.guiding.nodes, four.stats.guiding.nodes);
+    EXPECT_EQ(one.stats.guiding_records, four.stats.guiding_records);
+    EXPECT_EQ(one.stats.spp, 4u);
+    EXPECT_TRUE(same_image(one.film, two.film)) << "1 and 2 threads gave different images";
+    EXPECT_TRUE(same_image(one.film, four.film)) << "1 and 4 threads gave different images";
+  }
+}
+
+// +rr:guided decides by what the guide learned and, where it learned
+// nothing, by the throughput rule: untrained (guided:0) it renders the very
+// image +rr renders; trained, another (its convergence to the same image:
+// Convergence.GuidedMixturesAgreeOnTheDoorScene).
+TEST(GuidingSession, RouletteByTheLearnedLightFallsBackToTheThroughputRule) {
+  const auto scene = small_door(24, 18);
+  const auto render = [&](const std::string& strategy) {
+    return testing::render_to_completion(scene, strategy, 8, 9, 2, std::chrono::seconds(300)).film;
+  };
+  EXPECT_TRUE(same_image(render("nee-mis+mix:cosine=0.5,guided:0=0.5+rr:guided:2"),
+                         render("nee-mis+mix:cosine=0.5,guided:0=0.5+rr:2")));
+  EXPECT_FALSE(same_image(render("nee-mis+mix:cosine=0.5,guided:3=0.5+rr:guided:2"),
+                          render("nee-mis+mix:cosine=0.5,guided:3=0.5+rr:2")));
 }
 
 // Runs `session` on `settings` to its end (it renders with two workers).

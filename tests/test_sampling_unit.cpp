@@ -291,13 +291,31 @@ TEST(StrategyParse, ContinuationsRouletteAndFastest) {
   EXPECT_EQ(Strategy::parse("nee-mis:balance+light-sa+rr:7").roulette_depth, 7);
   EXPECT_TRUE(Strategy::parse("nee-mis:balance+light-sa+rr:7").is_unbiased() == false);
   for (const char* text : {"cosine+rr", "cosine+rr:1", "mix:cosine=1,light=3+rr:12", "nee-mis+rr",
-                           "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2", "nee-mis+uniform-sphere"}) {
+                           "nee-mis:balance+mix:cosine=0.3,light-sa=0.7+rr:2", "nee-mis+uniform-sphere",
+                           "nee-mis+mix:cosine=0.5,guided=0.5+rr:guided", "mix:cosine=0.5,guided:3=0.5+sobol+rr:guided:4"}) {
     const Strategy s = Strategy::parse(text);
     const Strategy back = Strategy::parse(s.to_string());
     EXPECT_EQ(back.to_string(), s.to_string()) << text;
     EXPECT_EQ(back.roulette_depth, s.roulette_depth) << text;
+    EXPECT_EQ(back.guided_roulette, s.guided_roulette) << text;
     EXPECT_EQ(back.nee_mis, s.nee_mis) << text;
   }
+  // +rr:guided: the roulette by the guide's learned light, the throughput
+  // rule from D (default kDefaultRouletteDepth) where it learned nothing.
+  const Strategy guided = Strategy::parse("nee-mis+mix:cosine=0.5,guided=0.5+rr:guided");
+  EXPECT_TRUE(guided.guided_roulette);
+  EXPECT_EQ(guided.roulette_depth, kDefaultRouletteDepth);
+  EXPECT_TRUE(guided.is_unbiased());
+  EXPECT_EQ(guided.to_string(), "nee-mis+mix:cosine=0.5,guided:5=0.5+rr:guided");
+  const Strategy from_four = Strategy::parse("mix:cosine=0.5,guided=0.5+rr:guided:4");
+  EXPECT_EQ(from_four.roulette_depth, 4);
+  EXPECT_EQ(from_four.to_string(), "mix:cosine=0.5,guided:5=0.5+rr:guided:4");
+  EXPECT_FALSE(Strategy::parse("mix:cosine=0.5,guided=0.5+rr:4").guided_roulette);
+  expect_rejected("nee-mis+rr:guided", {"+rr:guided", "no guided technique"});
+  expect_rejected("fastest+rr:guided", {"+rr:guided", "no guided technique"});
+  expect_rejected("mix:cosine=0.5,guided=0.5+rr:guided:0", {"'rr:guided:0'", "1..10000"});
+  expect_rejected("mix:cosine=0.5,guided=0.5+rr:guide", {"'rr:guide'"});
+  expect_rejected("cosine+rr:5:3", {"'rr:5:3'"});
   EXPECT_EQ(with_roulette(Strategy::parse("cosine"), 5).to_string(), "cosine+rr:5");
   EXPECT_EQ(with_roulette(Strategy::parse("cosine+rr:2"), 0).to_string(), "cosine+rr:2");
   const Strategy fastest = Strategy::parse("fastest");

@@ -365,6 +365,13 @@ void path_options(SamplingSettings& s) {
     ImGui::SameLine();
     ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
     ImGui::SliderInt("from depth", &s.roulette_depth, 1, 20, "%d", ImGuiSliderFlags_AlwaysClamp);
+    if (s.strategy_without_name().uses(Technique::Guided)) {
+      ImGui::Checkbox("by the learned light", &s.guided_roulette);
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("+rr:guided: a path goes on in proportion to the light the guide expects it to\n"
+                          "bring over what its pixel was expected to get, however small its throughput;\n"
+                          "where the guide learned nothing, the throughput rule from the depth above");
+    }
   }
   ImGui::Checkbox("Sobol sampler", &s.sobol);
   if (ImGui::IsItemHovered())

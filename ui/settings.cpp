@@ -14,6 +14,7 @@ Strategy SamplingSettings::strategy() const {
   }
   s.parameters = parameters;
   s.roulette_depth = roulette_depth;
+  s.guided_roulette = guided_roulette && roulette_depth > 0 && s.uses(Technique::Guided);
   s.sobol = sobol;
   s.fastest = fastest && s == fastest_sampling().strategy_without_name();
   return s;
@@ -35,6 +36,7 @@ SamplingSettings SamplingSettings::from(const Strategy& strategy) {
   SamplingSettings out;
   out.parameters = strategy.parameters;
   out.roulette_depth = strategy.roulette_depth;
+  out.guided_roulette = strategy.guided_roulette;
   out.sobol = strategy.sobol;
   out.fastest = strategy.fastest;
   out.light_choice = strategy.light_choice;

@@ -30,6 +30,7 @@ struct SamplingSettings {
   // such as `fastest` set another).
   std::array<float, kTechniqueCount> continuation = Strategy::nee().weights;
   int roulette_depth = 0;  // Strategy::roulette_depth, for any of the above
+  bool guided_roulette = false;  // Strategy::guided_roulette, kept only where the strategy has guided
   bool sobol = false;      // Strategy::sobol (the stratified sampler), for any of the above
   bool fastest = false;    // the `fastest` preset, as it expands
   // nee-mis's light choice (Strategy::light_choice; none: the scene's).

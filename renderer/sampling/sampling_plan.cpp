@@ -117,6 +117,7 @@ SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   plan.nee_mis = strategy.nee_mis;
   plan.heuristic = strategy.heuristic;
   plan.roulette_depth = strategy.roulette_depth;
+  plan.guided_roulette = strategy.guided_roulette;
   plan.sobol = strategy.sobol;
   plan.light_choice = strategy.light_choice.value_or(scene.light_choice);
   plan.bind_targets();

@@ -33,7 +33,7 @@ std::string known_list() {
     out.append(t.name);
     if (!t.parameter.empty()) out.append("[:").append(t.parameter).append("]");
   }
-  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +sobol, +rr or +rr:D)";
+  return out + ", mix:TECHNIQUE=W,..., nee-mis, nee-mis:balance, nee-mis+STRATEGY, fastest (each with +sobol, +rr or +rr:D; with guided +rr:guided)";
 }
 
 // The shortest decimal that reads back as the same float: a strategy's text
@@ -171,7 +171,7 @@ std::string technique_table_markdown() {
 
 std::string strategy_help() {
   std::string out =
-      "Strategies: BASE[+sobol][+rr[:D]][+lights:CHOICE] | fastest[+sobol][+rr[:D]][+lights:CHOICE]\n"
+      "Strategies: BASE[+sobol][+rr[:guided][:D]][+lights:CHOICE] | fastest[+sobol][+rr[:D]][+lights:CHOICE]\n"
       "  BASE := MIXTURE | nee-mis[:balance][+MIXTURE]\n"
       "  MIXTURE := TECHNIQUE | mix:TECHNIQUE=W,TECHNIQUE=W[,...]\n"
       "  nee-mis: a light sample and a continuation at each diffuse vertex, weighed by MIS (power heuristic,\n"
@@ -183,6 +183,9 @@ std::string strategy_help() {
       "  +rr[:D]: Russian roulette from D path segments on (default " + std::to_string(kDefaultRouletteDepth) +
       "): a path goes on with probability\n"
       "    min(1, largest throughput component), its throughput divided by it (unbiased; off by default)\n"
+      "  +rr:guided[:D] (with guided): Russian roulette by the light the guide learned: a path goes on in\n"
+      "    proportion to the light it is expected to bring over its pixel's, however small its throughput\n"
+      "    (where the guide learned nothing, the throughput rule from D)\n"
       "  +sobol: " + stratified_vertices() +
       " draws (continuation, light sample, specular bounce) from Owen-scrambled Sobol points\n"
       "    stratified across a pixel's samples, the rest from the sample's random stream (unbiased;\n"
@@ -265,17 +268,19 @@ Strategy parse_mixture(std::string_view text, std::string_view whole) {
   return s;
 }
 
-// rr or rr:D.
-int parse_roulette(std::string_view text, std::string_view whole) {
-  if (text == "rr") return kDefaultRouletteDepth;
-  const std::string_view depth = text.substr(text.find(':') + 1);
+// rr, rr:D, rr:guided or rr:guided:D (`guided` set for the last two).
+int parse_roulette(std::string_view text, std::string_view whole, bool& guided) {
+  guided = text == "rr:guided" || text.substr(0, 10) == "rr:guided:";
+  if (text == "rr" || text == "rr:guided") return kDefaultRouletteDepth;
+  const std::string_view depth = text.substr(guided ? 10 : text.find(':') + 1);
   int value = 0;
   const auto* end = depth.data() + depth.size();
   auto [ptr, ec] = std::from_chars(depth.data(), end, value);
   if (text.substr(0, 3) != "rr:" || depth.empty() || ec != std::errc() || ptr != end || value < 1 ||
       value > kMaxRouletteDepth)
     throw InputError("strategy '" + std::string(whole) + "': '" + std::string(text) +
-                     "' is not rr or rr:D with D, the first depth of Russian roulette, an integer in 1.." +
+                     "' is not rr, rr:D, rr:guided or rr:guided:D with D, the first depth of Russian roulette "
+                     "(by throughput), an integer in 1.." +
                      std::to_string(kMaxRouletteDepth));
   return value;
 }
@@ -289,6 +294,7 @@ Strategy Strategy::parse(std::string_view text) {
   // Last terms `sobol` and `rr[:D]`, in either order, choose the sampler and
   // turn on Russian roulette.
   int roulette = 0;
+  bool guided_roulette = false;
   bool sobol = false;
   std::optional<LightChoice> lights;
   for (;;) {
@@ -301,7 +307,7 @@ Strategy Strategy::parse(std::string_view text) {
         throw InputError("strategy '" + std::string(whole) + "': the light choice must be 'power', 'uniform' or 'tree'");
       lights = c;
     } else if (term.substr(0, 2) == "rr" && !roulette) {
-      roulette = parse_roulette(term, whole);
+      roulette = parse_roulette(term, whole, guided_roulette);
     } else if (term == "sobol" && !sobol) {
       sobol = true;
     } else {
@@ -309,8 +315,14 @@ Strategy Strategy::parse(std::string_view text) {
     }
     body = trim(body.substr(0, last_plus));
   }
+  const auto no_guide = [&] {
+    return InputError("strategy '" + std::string(whole) +
+                      "': +rr:guided is Russian roulette by the light the guided technique learns, and the strategy "
+                      "has no guided technique");
+  };
   Strategy s;
   if (body == "fastest") {
+    if (guided_roulette) throw no_guide();
     s = parse(kFastestStrategy);
     s.fastest = true;
     if (roulette) s.roulette_depth = roulette;
@@ -339,7 +351,9 @@ Strategy Strategy::parse(std::string_view text) {
   }
   if (lights && !s.nee_mis)
     throw InputError("strategy '" + std::string(whole) + "': +lights chooses nee-mis's light sample; the strategy has none");
+  if (guided_roulette && !s.uses(Technique::Guided)) throw no_guide();
   s.roulette_depth = roulette;
+  s.guided_roulette = guided_roulette;
   s.sobol = sobol;
   s.light_choice = lights;
   return s;
@@ -361,7 +375,7 @@ std::string Strategy::to_string() const {
   }
   if (sobol) out.append("+sobol");
   if (roulette_depth > 0) {
-    out.append("+rr");
+    out.append(guided_roulette ? "+rr:guided" : "+rr");
     if (roulette_depth != kDefaultRouletteDepth) out.append(":").append(std::to_string(roulette_depth));
   }
   if (light_choice) out.append("+lights:").append(light_choice_name(*light_choice));

@@ -58,6 +58,11 @@ inline constexpr std::string_view kFastestStrategy = "nee-mis+mix:cosine=0.8,spe
 // Russian roulette's default first depth, and the largest one accepted.
 inline constexpr int kDefaultRouletteDepth = 3;
 inline constexpr int kMaxRouletteDepth = 10000;
+// `+rr:guided`'s rule (Strategy::guided_roulette): a path goes on with
+// probability min(1, max(kGuidedRouletteScale r, the throughput rule's q)).
+// The scale sets how far below its share of the pixel's light a path may
+// fall before it is cut (docs/guiding.md: 3 to 30 measured, 5 to 10 alike).
+inline constexpr float kGuidedRouletteScale = 5.0f;
 
 // As typed by the user: `cosine`, `mix:cosine=1,light=3`, `nee-mis`,
 // `nee-mis:balance`, `nee-mis+mix:cosine=0.5,light=0.5`, any of them with
@@ -83,6 +88,15 @@ struct Strategy {
   // path goes on with probability min(1, largest component of throughput *
   // albedo), its throughput divided by that (leaf::russian_roulette).
   int roulette_depth = 0;
+  // `+rr:guided` (a strategy with the guided technique): Russian roulette by
+  // the light the guide learned (after Vorba and Krivanek's adjoint-driven
+  // roulette): at every diffuse vertex after the path's first, it goes on with
+  // probability min(1, max(kGuidedRouletteScale r, the throughput rule's q)),
+  // r the light it is expected to bring from there (throughput x albedo x the
+  // learned light at the vertex) over what it was expected to bring at its
+  // first diffuse vertex. Where the guide has learned nothing, the throughput
+  // rule from roulette_depth. docs/guiding.md, "The roulette by the learned light".
+  bool guided_roulette = false;
   // `+sobol`: the first diffuse and specular vertices' draws (the continuation's
   // technique and direction, the light sample's emitter and point, a specular
   // bounce's numbers) at path depths below qmc::kDepths come from Owen-scrambled
@@ -164,6 +178,7 @@ struct SamplingPlan {
   bool cosine_continuation = false;
   bool continuation_mixes = false;
   int roulette_depth = 0;  // Strategy::roulette_depth
+  bool guided_roulette = false;  // Strategy::guided_roulette
   bool sobol = false;      // Strategy::sobol
   // Whether the vertex reached by segment `depth` takes its draws from the
   // `+sobol` sampler's stratified points (depth -1: never).
