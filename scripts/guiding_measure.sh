@@ -26,7 +26,7 @@ ref_spp=${REF_SPP:-16384}
 width=${WIDTH:-100}
 height=${HEIGHT:-75}
 scene=${SCENE:-$here/assets/scenes/door_ajar.json}
-read -r -a strategies <<< "${STRATEGIES:-fastest nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10 nee-mis+mix:cosine=0.7,guided=0.3+sobol+rr:10 nee-mis+mix:cosine=0.7,guided:7=0.3+sobol+rr:10}"
+read -r -a strategies <<< "${STRATEGIES:-fastest nee-mis+mix:cosine=0.3,guided=0.7+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10}"
 size=(--width "$width" --height "$height")
 mkdir -p "$out"
 
