@@ -161,6 +161,7 @@ BenchPlan plan_bench(const BenchOptions& o) {
   BenchPlan plan;
   plan.scene = std::make_shared<Scene>(load_scene_file(o.scene));
   plan.strategies = parse_strategy_list(o.strategies, o.roulette_depth);
+  for (Strategy& s : plan.strategies) s = for_scene(s, *plan.scene);
   for (const Strategy& s : plan.strategies) (void)SamplingPlan::make(s, *plan.scene);
   plan.prediction = o.predict.empty() ? Prediction{} : plan_prediction(o.predict, plan.strategies);
   plan.reference = comparison_reference(*plan.scene, reference_choice(o), plan.strategies, {o.seed}, o.quiet);

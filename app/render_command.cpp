@@ -193,10 +193,7 @@ Resumed open_resume(const RenderOptions& o) {
   const SampleRange& range = info.ranges.front();
   if (!o.scene_given) r.scene = info.scene_file;
   if (!o.strategy_given) r.strategy = info.strategy;
-  if ((o.strategy_given || o.roulette_depth > 0) &&
-      with_roulette(Strategy::parse(r.strategy), o.roulette_depth).to_string() != info.strategy)
-    throw InputError("--resume: " + film + " was rendered with strategy '" + info.strategy + "', not '" +
-                     with_roulette(Strategy::parse(r.strategy), o.roulette_depth).to_string() + "'");
+  (void)Strategy::parse(r.strategy);  // bad input before anything is read further; compared with the scene below
   if (o.seed_given && o.seed != range.seed)
     throw InputError("--resume: " + film + " was rendered with seed " + std::to_string(range.seed) + ", not " +
                      std::to_string(o.seed));
@@ -267,7 +264,11 @@ RenderPlan plan_render(const RenderOptions& o) {
   if (height != 0) scene.camera.height = height;
   if (width != 0 || height != 0) check_image_size(scene.camera.width, scene.camera.height, "--width/--height");
   scene.prepare();
-  plan.strategy = with_roulette(Strategy::parse(strategy_text), o.roulette_depth);
+  plan.strategy = for_scene(with_roulette(Strategy::parse(strategy_text), o.roulette_depth), scene);
+  if (resumed && (o.strategy_given || o.roulette_depth > 0) &&
+      plan.strategy.to_string() != resumed->file.info.strategy)
+    throw InputError("--resume: film '" + o.resume + "' was rendered with strategy '" + resumed->file.info.strategy +
+                     "', not '" + plan.strategy.to_string() + "'");
   (void)SamplingPlan::make(plan.strategy, scene);  // strategy/scene mismatch is bad input too
 
   FilmInfo& info = plan.info;

@@ -130,7 +130,7 @@ void TeachingViews::restart_split(const RenderSettings& main_settings) {
   RenderSettings rb = ra;
   split_.b_error.clear();
   try {
-    rb.strategy = Strategy::parse(split_.b_strategy);
+    rb.strategy = for_scene(Strategy::parse(split_.b_strategy), *rb.scene);
     (void)SamplingPlan::make(rb.strategy, *rb.scene);
   } catch (const InputError& e) {
     split_.b_error = e.what();

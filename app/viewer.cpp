@@ -359,9 +359,11 @@ void Viewer::Impl::continue_film(const std::string& path) {
   if (f.ranges.size() != 1)
     throw InputError("--resume: film '" + path + "' is a merge of " + std::to_string(f.ranges.size()) +
                      " renders; only one render's film can be continued");
-  if (f.strategy != settings.sampling.strategy().to_string())
-    throw InputError("--resume: film '" + path + "' was rendered with strategy '" + f.strategy + "', not '" +
-                     settings.sampling.strategy().to_string() + "'");
+  const std::string given =
+      (base_scene ? for_scene(settings.sampling.strategy(), *base_scene) : settings.sampling.strategy()).to_string();
+  if (f.strategy != given)
+    throw InputError("--resume: film '" + path + "' was rendered with strategy '" + f.strategy + "', not '" + given +
+                     "'");
   settings.seed = f.ranges.front().seed;
   settings.max_depth = f.max_depth;
   settings.width_override = f.width;
@@ -606,6 +608,12 @@ void Viewer::Impl::close() {
 }
 
 bool Viewer::Impl::apply_render_settings() {
+  // `fastest` on a scene whose light is hard to find runs as path guiding
+  // (for_scene): the panel then shows, and the sidecars record, what runs.
+  if (settings.sampling.fastest && base_scene && base_scene->fastest_uses_guiding) {
+    settings.sampling = ui::SamplingSettings::from(for_scene(settings.sampling.strategy(), *base_scene));
+    settings.sampling.fastest = false;
+  }
   const Strategy strategy = settings.sampling.strategy();
   if (!strategy.nee_mis && all_zero(strategy)) {
     status.settings_error = "Every mixture weight is 0; still showing the last valid strategy.";

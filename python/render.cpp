@@ -70,7 +70,7 @@ class RenderHandle {
     if (height) scene->camera.height = *height;
     if (width || height) check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
     scene->prepare();
-    strategy_ = with_roulette(Strategy::parse(strategy_text), roulette_depth);
+    strategy_ = for_scene(with_roulette(Strategy::parse(strategy_text), roulette_depth), *scene);
     (void)SamplingPlan::make(strategy_, *scene);  // strategy/scene mismatch is bad input too
 
     target_spp_ = spp ? static_cast<std::uint32_t>(*spp) : 0;

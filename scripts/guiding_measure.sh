@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Path guiding against `fastest` on assets/scenes/door_ajar.json at equal time,
 # the training included (docs/guiding.md, "Measured"), from the CLI alone:
-#   1. a reference (pdflab reference, REF_SPP samples per pixel of `fastest`:
+#   1. a reference (pdflab reference, REF_SPP samples per pixel of `fastest` as
+#      it is on general scenes (the door scene's own `fastest` is guided):
 #      the established estimator, so that a fault of guiding cannot hide in
 #      the reference; the summary says how many times the largest run's
 #      samples it holds);
-#   2. equal time, training included: the first strategy (fastest) rendered
+#   2. equal time, training included: the first strategy (general `fastest`) rendered
 #      at SPP samples per pixel on one thread takes T seconds (the render's
 #      own clock); each other strategy is timed at SPP and 2 SPP (seed 7),
 #      which gives its training time and its time per sample, and is then
@@ -26,11 +27,16 @@ ref_spp=${REF_SPP:-16384}
 width=${WIDTH:-100}
 height=${HEIGHT:-75}
 scene=${SCENE:-$here/assets/scenes/door_ajar.json}
-read -r -a strategies <<< "${STRATEGIES:-fastest nee-mis+mix:cosine=0.3,guided=0.7+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10}"
+# On the door scene `fastest` itself runs as path guiding (the scene sets
+# fastest_uses_guiding), so the baseline and the reference name what fastest
+# is on general scenes, as `pdflab --help` prints it.
+general=$("$pdflab" --help | sed -n 's/^ *fastest: .* now \([^ ]*\)$/\1/p')
+[ -n "$general" ] || { echo "guiding_measure.sh: cannot read fastest's expansion from pdflab --help" >&2; exit 2; }
+read -r -a strategies <<< "${STRATEGIES:-$general nee-mis+mix:cosine=0.3,guided=0.7+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:guided nee-mis+mix:cosine=0.5,guided=0.5+sobol+rr:10}"
 size=(--width "$width" --height "$height")
 mkdir -p "$out"
 
-[ -f "$out/ref.pfm" ] || "$pdflab" reference --scene "$scene" "${size[@]}" --strategy fastest \
+[ -f "$out/ref.pfm" ] || "$pdflab" reference --scene "$scene" "${size[@]}" --strategy "$general" \
   --spp "$ref_spp" --out "$out/ref.pfm" --cache-dir "$out/cache" --quiet
 
 # render STRATEGY SEED SPP [REFERENCE]: one render on one thread; its summary in $out/run.json.

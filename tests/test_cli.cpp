@@ -154,6 +154,34 @@ std::vector<std::string> small_render(const std::string& out, std::initializer_l
   return a;
 }
 
+// On the door scene `fastest` runs as path guiding (for_scene), and the
+// sidecar and the statistics say so: the guided expansion, from fastest.
+TEST_F(RenderCommand, FastestRunsAsGuidingWhereTheSceneSaysSo) {
+  const std::string door = std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/door_ajar.json";
+  const ChildResult r = run({"render", "--scene", door, "--strategy", "fastest", "--spp", "2", "--width", "24",
+                             "--height", "18", "--threads", "2", "--out", in_work("door.pfm"), "--film-out",
+                             in_work("door.film"), "--stats-json", in_work("stats.json")});
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("path guiding: 5 training passes"), std::string::npos) << r.out;
+  const nlohmann::json sidecar = nlohmann::json::parse(slurp(work() / "door.json"));
+  EXPECT_EQ(sidecar.at("strategy").get<std::string>(), Strategy::parse(kFastestGuidedStrategy).to_string());
+  const nlohmann::json stats = nlohmann::json::parse(slurp(work() / "stats.json"));
+  EXPECT_EQ(stats.at("strategy"), sidecar.at("strategy"));
+  EXPECT_EQ(stats.at("expanded_from").get<std::string>(), "fastest");
+  // Resumed with --strategy fastest, the film's strategy is what fastest is there.
+  const ChildResult again = run({"render", "--resume", in_work("door.film"), "--strategy", "fastest", "--spp", "2",
+                                 "--threads", "2", "--out", in_work("door2.pfm")});
+  ASSERT_TRUE(again.exited);
+  EXPECT_EQ(again.status, 0) << again.err;
+  const std::vector<std::string> before = work_entries();
+  const ChildResult other = run({"render", "--resume", in_work("door.film"), "--strategy", "nee-mis", "--spp", "2",
+                                 "--out", in_work("door3.pfm")});
+  EXPECT_EQ(other.status, 2) << other.err;
+  EXPECT_NE(other.err.find("was rendered with strategy"), std::string::npos) << other.err;
+  EXPECT_EQ(work_entries(), before) << "a refused resume wrote files";
+}
+
 TEST_F(RenderCommand, RendersPfmAndStatsJson) {
   const ChildResult r = run(small_render(in_work("image.pfm"), {"--stats-json", in_work("stats.json"), "--seed", "5"}));
   ASSERT_TRUE(r.exited);

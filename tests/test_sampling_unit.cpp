@@ -334,6 +334,37 @@ TEST(StrategyParse, ContinuationsRouletteAndFastest) {
 // specular-objects aims at the glass and metal objects, found by material;
 // where a scene has none it gets no weight, and fastest's continuation is
 // then cosine alone (the bits of nee-mis+sobol+rr:5); alone there it is refused.
+// `fastest` runs as path guiding where the scene says its light is hard to
+// find (door_ajar.json), keeping what was given to fastest; elsewhere, and
+// any other strategy anywhere, as parsed.
+TEST(SamplingPlan, FastestUsesGuidingWhereTheSceneSaysSo) {
+  const auto scene = [](const char* file) {
+    return load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);
+  };
+  const Scene door = scene("door_ajar.json"), book = scene("cornell_book.json");
+  ASSERT_TRUE(door.fastest_uses_guiding);
+  EXPECT_FALSE(book.fastest_uses_guiding);
+  const Strategy fastest = Strategy::parse("fastest");
+  EXPECT_EQ(for_scene(fastest, book), fastest);
+  const Strategy guided = for_scene(fastest, door);
+  EXPECT_TRUE(guided.fastest);
+  EXPECT_TRUE(guided.uses(Technique::Guided));
+  EXPECT_TRUE(guided.guided_roulette);
+  EXPECT_TRUE(guided.is_unbiased());
+  EXPECT_EQ(guided.to_string(), Strategy::parse(kFastestGuidedStrategy).to_string());
+  EXPECT_GT(SamplingPlan::make(guided, door).weight[static_cast<int>(Technique::Guided)], 0.0f);
+  // +rr:D given to fastest is the guided roulette's fallback depth.
+  const Strategy from_five = for_scene(Strategy::parse("fastest+rr:5"), door);
+  EXPECT_EQ(from_five.roulette_depth, 5);
+  EXPECT_TRUE(from_five.guided_roulette);
+  EXPECT_EQ(for_scene(Strategy::parse("fastest+lights:uniform"), door).light_choice, LightChoice::Uniform);
+  // Anything else is left as it is, on the door scene too.
+  const Strategy nee = Strategy::parse("nee-mis+sobol+rr:10");
+  EXPECT_EQ(for_scene(nee, door), nee);
+  // A strategy written out (what a film or sidecar records) reads back as itself.
+  EXPECT_EQ(for_scene(Strategy::parse(guided.to_string()), door).to_string(), guided.to_string());
+}
+
 TEST(SamplingPlan, SpecularObjectsAreTheGlassAndMetalObjects) {
   const auto scene = [](const char* file) {
     return load_scene_file(std::string(PDFLAB_SOURCE_DIR) + "/assets/scenes/" + file);

@@ -561,11 +561,23 @@ TEST(SceneValidation, DuplicateKeysAreRefusedWithTheirPath) {
   }
 }
 
+// `fastest_uses_guiding`: false unless the scene says true; anything but a
+// boolean is refused by name.
+TEST(SceneLoader, FastestUsesGuidingIsABoolean) {
+  EXPECT_FALSE(load_scene_text(minimal_scene().dump(), "scene.json").fastest_uses_guiding);
+  json doc = minimal_scene();
+  doc["fastest_uses_guiding"] = true;
+  EXPECT_TRUE(load_scene_text(doc.dump(), "scene.json").fastest_uses_guiding);
+  doc["fastest_uses_guiding"] = "yes";
+  expect_error_mentions(doc, {"fastest_uses_guiding"});
+}
+
 // Issue 33, item 13: a NUL in a key no longer cuts the message short (it was
 // a C string once made into the exception); it shows as \x00 with the rest.
 TEST(SceneValidation, ANulInAKeyIsShownNotCut) {
   const std::string message = load_error(R"({"cam\u0000era": 1, "camera": {}})");
-  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, environment, light_choice, materials, name, objects)"),
+  EXPECT_NE(message.find("unknown key 'cam\\x00era' (allowed: camera, description, environment, fastest_uses_guiding, "
+                         "light_choice, materials, name, objects)"),
             std::string::npos)
       << message;
 }

@@ -111,6 +111,20 @@ void SamplingPlan::set_technique_choice(const Strategy& strategy) {
 #undef PDFLAB_ROW
 }
 
+Strategy for_scene(const Strategy& strategy, const Scene& scene) {
+  if (!strategy.fastest || !scene.fastest_uses_guiding) return strategy;
+  static const Strategy general = Strategy::parse(kFastestStrategy);
+  Strategy out = Strategy::parse(kFastestGuidedStrategy);
+  out.fastest = true;
+  out.sobol = strategy.sobol;
+  out.light_choice = strategy.light_choice;
+  // A roulette depth given to fastest (+rr:D, --rr) is the guided roulette's
+  // fallback; none at all, none.
+  if (strategy.roulette_depth != general.roulette_depth) out.roulette_depth = strategy.roulette_depth;
+  out.guided_roulette = out.roulette_depth > 0;
+  return out;
+}
+
 SamplingPlan SamplingPlan::make(const Strategy& strategy, const Scene& scene) {
   SamplingPlan plan;
   plan.scene = &scene;

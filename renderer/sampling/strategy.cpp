@@ -193,7 +193,8 @@ std::string strategy_help() {
       "  +lights:CHOICE (nee-mis): how the light sample's emitter is chosen: power (the default, or the scene's\n"
       "    light_choice), uniform, or tree (a light tree: power, distance and orientation from the point)\n"
       "  fastest: pdflab's most efficient unbiased strategy for general scenes, now " + std::string(kFastestStrategy) +
-      "\nTechniques:\n";
+      "\n    (where a scene sets fastest_uses_guiding, its light hard to find: " + std::string(kFastestGuidedStrategy) +
+      ")\nTechniques:\n";
   for (const TechniqueInfo& t : kTable) {
     const std::string name = spelled_with_parameter(t);
     out.append("  ").append(name).append(name.size() < 22 ? 22 - name.size() : 1, ' ');

@@ -55,6 +55,15 @@ std::string_view technique_name(Technique t);
 // over the eighth and the six other scenes lose 0-6%.
 inline constexpr std::string_view kFastestStrategy = "nee-mis+mix:cosine=0.8,specular-objects=0.2+sobol+rr:10";
 
+// What `fastest` is instead where a scene says its light is hard to find
+// (Scene::fastest_uses_guiding, the scene file's `fastest_uses_guiding`:
+// door_ajar.json, its lamp behind a partition): path guiding's mixture with
+// the roulette by the learned light, 2.23x kFastestStrategy's efficiency there
+// at equal time with its training (docs/guiding.md, "Measured"). Not for
+// general scenes: where nee-mis finds the light from everywhere, guiding adds
+// its training and its cost per sample for nothing.
+inline constexpr std::string_view kFastestGuidedStrategy = "nee-mis+mix:cosine=0.3,guided=0.7+sobol+rr:guided";
+
 // Russian roulette's default first depth, and the largest one accepted.
 inline constexpr int kDefaultRouletteDepth = 3;
 inline constexpr int kMaxRouletteDepth = 10000;
@@ -133,6 +142,13 @@ struct Strategy {
  private:
   std::string mixture_string() const;  // the techniques and weights alone
 };
+
+// `strategy` as it runs on `scene`: `fastest` there is kFastestGuidedStrategy
+// where the scene says so (Scene::fastest_uses_guiding), with the sampler,
+// the light choice and a roulette depth given to `fastest` kept; every other
+// strategy as it is. Wherever a strategy meets its scene (a render, the
+// viewer, bench, a reference), so that what is reported is what ran.
+Strategy for_scene(const Strategy& strategy, const Scene& scene);
 
 // `strategy` with Russian roulette from `depth` on (the command lines' --rr);
 // depth 0 leaves it as it is.

@@ -167,6 +167,9 @@ struct Scene {
   // How nee-mis chooses its light sample's emitter where the strategy does not
   // say (the scene file's `light_choice`).
   LightChoice light_choice = LightChoice::Power;
+  // The scene file's `fastest_uses_guiding`: its light is hard to find (behind
+  // a door ajar), and `fastest` there is kFastestGuidedStrategy (for_scene).
+  bool fastest_uses_guiding = false;
   // The environment light (scene file's `environment`): the radiance of a ray
   // that leaves the scene, in place of `background`; null: none.
   std::shared_ptr<const Environment> environment;

@@ -556,7 +556,8 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
                      ": the key appears twice in its object (JSON would keep only the last value)");
   Node root(doc, "", origin);
   root.expect_object();
-  root.allow_only({"name", "description", "camera", "materials", "objects", "environment", "light_choice"});
+  root.allow_only(
+      {"name", "description", "camera", "materials", "objects", "environment", "light_choice", "fastest_uses_guiding"});
 
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : origin;
@@ -566,6 +567,7 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     if (!parse_light_choice(choice.string(), scene.light_choice))
       choice.fail("unknown light choice '" + choice.string() + "' (allowed: power, uniform, tree)");
   }
+  if (root.has("fastest_uses_guiding")) scene.fastest_uses_guiding = root.child("fastest_uses_guiding").boolean();
   Placement placement;
   parse_camera(root.require("camera"), scene, placement);
 
