@@ -168,6 +168,7 @@ bool WeightLab::update(const Input& in) {
   pair.a = term_name(in.a);
   pair.b = term_name(in.b);
   pair.roulette_depth = in.strategy.roulette_depth;  // the paths' own (the prediction weighs its checks)
+  pair.guided_roulette = in.strategy.guided_roulette;
   maps_.a = pair.a;
   maps_.b = pair.b;
   const double w = pair.weight_of(in.strategy);

@@ -123,7 +123,9 @@ TEST(WeightPaths, PredictedMomentMatchesTheMeasuredOne) {
 // A mixture of cosine and a trained `guided`: with the distribution frozen
 // (WeightPathOptions::guiding, as a render's replay passes it), the moment
 // predicted at w from paths drawn at 0.5 matches the one measured from paths
-// drawn at w; the untrained sphere in its place predicts another.
+// drawn at w, without roulette and with the roulette by the learned light
+// from the first vertex on (whose q, like the throughput rule's, scales with
+// the throughput); the untrained sphere in its place predicts another.
 TEST(WeightPaths, PredictionWithAFrozenGuideMatchesTheMeasuredOne) {
   const Scene scene = small_box(12);
   GuidingTrainer trainer(scene);
@@ -143,25 +145,44 @@ TEST(WeightPaths, PredictionWithAFrozenGuideMatchesTheMeasuredOne) {
   MixtureFamily family;
   family.a = Strategy::parse("cosine");
   family.b = Strategy::parse("guided");
-  const auto drawn = [&](double w, std::uint64_t seed, const GuidingDistribution* g) {
-    char text[64];
-    std::snprintf(text, sizeof text, "mix:cosine=%g,guided=%g", w, 1.0 - w);
-    WeightPathOptions o;
-    o.samples = 2048;
-    o.threads = 2;
-    o.seed = seed;
-    o.guiding = g;
-    return record_weight_paths(scene, family, Strategy::parse(text), w, {0.25, 0.5, 0.8}, o);
-  };
-  const std::vector<float> mean = mean_image(scene);
-  const WeightPredictor drawn_half = drawn(0.5, 11, guide.get());
-  const WeightPredictor untrained_half = drawn(0.5, 11, nullptr);
-  for (double w : {0.25, 0.8}) {
-    const std::size_t g = w < 0.5 ? 0 : 2;
-    const double measured = image_moment(drawn(w, 21, guide.get()), g, mean);
-    EXPECT_NEAR(image_moment(drawn_half, g, mean), measured, 0.1 * measured) << "at " << w;
-    EXPECT_GT(std::fabs(image_moment(untrained_half, g, mean) - measured), 0.1 * measured) << "at " << w;
+  for (const char* roulette : {"", "+rr:guided:1"}) {
+    SCOPED_TRACE(roulette);
+    const auto drawn = [&](double w, std::uint64_t seed, const GuidingDistribution* g) {
+      char text[64];
+      std::snprintf(text, sizeof text, "mix:cosine=%g,guided=%g%s", w, 1.0 - w, roulette);
+      WeightPathOptions o;
+      o.samples = 2048;
+      o.threads = 2;
+      o.seed = seed;
+      o.guiding = g;
+      return record_weight_paths(scene, family, Strategy::parse(text), w, {0.25, 0.5, 0.8}, o);
+    };
+    const std::vector<float> mean = mean_image(scene);
+    const WeightPredictor drawn_half = drawn(0.5, 11, guide.get());
+    const WeightPredictor untrained_half = drawn(0.5, 11, nullptr);
+    for (double w : {0.25, 0.8}) {
+      const std::size_t g = w < 0.5 ? 0 : 2;
+      const double measured = image_moment(drawn(w, 21, guide.get()), g, mean);
+      EXPECT_NEAR(image_moment(drawn_half, g, mean), measured, 0.1 * measured) << "at " << w;
+      EXPECT_GT(std::fabs(image_moment(untrained_half, g, mean) - measured), 0.1 * measured) << "at " << w;
+    }
   }
+}
+
+// A sweep's family keeps the roulette by the learned light in every member
+// that has the guided technique, and knows its members by it.
+TEST(WeightPaths, AFamilyKeepsTheRouletteByTheLearnedLight) {
+  const TechniquePair pair = parse_technique_pair("cosine,guided", "mix:cosine=0.5,guided=0.5+rr:guided");
+  EXPECT_TRUE(pair.guided_roulette);
+  const Strategy member = pair.at(0.3);
+  EXPECT_TRUE(member.guided_roulette);
+  EXPECT_EQ(member.roulette_depth, kDefaultRouletteDepth);
+  EXPECT_NEAR(pair.weight_of(member), 0.3, 1e-6);
+  EXPECT_FALSE(pair.at(1.0).guided_roulette) << "no guided technique at w = 1";
+  EXPECT_NEAR(pair.weight_of(pair.at(1.0)), 1.0, 1e-6);
+  EXPECT_LT(pair.weight_of(Strategy::parse("mix:cosine=0.3,guided=0.7+rr")), 0.0)
+      << "the throughput's roulette makes another family";
+  EXPECT_FALSE(parse_technique_pair("cosine,guided", "mix:cosine=0.5,guided=0.5+rr").at(0.3).guided_roulette);
 }
 
 // With Russian roulette the survival probability depends on the weight the

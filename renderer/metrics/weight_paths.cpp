@@ -46,7 +46,10 @@ Strategy TechniquePair::at(double w) const {
     std::snprintf(buf, sizeof buf, ",%s=%.9g", name.c_str(), weight);
     text += buf;
   }
-  return with_roulette(Strategy::parse(text), roulette_depth);
+  Strategy s = with_roulette(Strategy::parse(text), roulette_depth);
+  // +rr:guided holds where the member has the guided technique and a roulette.
+  s.guided_roulette = guided_roulette && s.roulette_depth > 0 && s.uses(Technique::Guided);
+  return s;
 }
 
 MixtureFamily TechniquePair::mixture_family() const {
@@ -63,7 +66,9 @@ MixtureFamily TechniquePair::mixture_family() const {
 }
 
 double TechniquePair::weight_of(const Strategy& strategy) const {
-  if (strategy.nee_mis || strategy.roulette_depth != roulette_depth) return -1.0;
+  if (strategy.nee_mis || strategy.roulette_depth != roulette_depth ||
+      strategy.guided_roulette != (guided_roulette && strategy.roulette_depth > 0 && strategy.uses(Technique::Guided)))
+    return -1.0;
   Strategy s = strategy;
   s.roulette_depth = 0;  // the mixture's terms alone
   double wa = 0.0, wb = 0.0;
@@ -102,6 +107,7 @@ TechniquePair parse_technique_pair(const std::string& vary, const std::string& b
   if (base.empty()) return f;
   Strategy s = Strategy::parse(base);
   if (s.roulette_depth > 0 && roulette_depth == 0) f.roulette_depth = s.roulette_depth;
+  f.guided_roulette = s.guided_roulette;
   s.roulette_depth = 0;  // the mixture's terms alone
   if (s.nee_mis) throw InputError("--strategy '" + base + "': nee-mis is not a mixture; sweep varies mixture weights");
   double pair = 0.0;

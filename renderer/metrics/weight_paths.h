@@ -30,6 +30,7 @@ struct TechniquePair {
   double share = 1.0;                                 // the pair's total weight
   std::vector<std::pair<std::string, double>> rest;  // the others, normalised weights
   int roulette_depth = 0;                             // Strategy::roulette_depth of every member
+  bool guided_roulette = false;                       // Strategy::guided_roulette of every member (+rr:guided)
 
   Strategy at(double w) const;           // the mixture at A's share w
   MixtureFamily mixture_family() const;  // the densities the predictor evaluates
