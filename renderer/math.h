@@ -35,7 +35,10 @@ inline float max_abs_component(const Vec3& a) {
 }
 // Rec. 709 luminance, in double: the brightness a viewer sees. The noise and
 // error measures, the viewer's readouts and an emitter's power all use it.
-inline constexpr double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+inline constexpr double kLuminanceR = 0.2126, kLuminanceG = 0.7152, kLuminanceB = 0.0722;
+inline constexpr double luminance(double r, double g, double b) {
+  return kLuminanceR * r + kLuminanceG * g + kLuminanceB * b;
+}
 template <class T>
 constexpr double luminance(const T* rgb) {
   return luminance(rgb[0], rgb[1], rgb[2]);

@@ -14,7 +14,7 @@ Strategy SamplingSettings::strategy() const {
   }
   s.parameters = parameters;
   s.roulette_depth = roulette_depth;
-  s.guided_roulette = guided_roulette && roulette_depth > 0 && s.uses(Technique::Guided);
+  s.guided_roulette = guided_roulette_holds(s, guided_roulette);
   s.sobol = sobol;
   s.fastest = fastest && s == fastest_sampling().strategy_without_name();
   return s;

@@ -47,8 +47,7 @@ Strategy TechniquePair::at(double w) const {
     text += buf;
   }
   Strategy s = with_roulette(Strategy::parse(text), roulette_depth);
-  // +rr:guided holds where the member has the guided technique and a roulette.
-  s.guided_roulette = guided_roulette && s.roulette_depth > 0 && s.uses(Technique::Guided);
+  s.guided_roulette = guided_roulette_holds(s, guided_roulette);
   return s;
 }
 
@@ -67,7 +66,7 @@ MixtureFamily TechniquePair::mixture_family() const {
 
 double TechniquePair::weight_of(const Strategy& strategy) const {
   if (strategy.nee_mis || strategy.roulette_depth != roulette_depth ||
-      strategy.guided_roulette != (guided_roulette && strategy.roulette_depth > 0 && strategy.uses(Technique::Guided)))
+      strategy.guided_roulette != guided_roulette_holds(strategy, guided_roulette))
     return -1.0;
   Strategy s = strategy;
   s.roulette_depth = 0;  // the mixture's terms alone
@@ -171,7 +170,7 @@ WeightPredictor record_weight_paths(const Scene& scene, const MixtureFamily& fam
           }
           if (o.film) o.film->add(static_cast<std::size_t>(y * width + x), radiance);  // pixels of disjoint rows
           if (o.technique_share) {
-            const double carried = 0.2126 * radiance.x + 0.7152 * radiance.y + 0.0722 * radiance.z;
+            const double carried = luminance(radiance.x, radiance.y, radiance.z);
             double* share = &(*o.technique_share)[static_cast<std::size_t>(y * width + x) * kShareKinds];
             if (carried > 0.0 && std::isfinite(carried)) {
               if (vertices.empty()) {

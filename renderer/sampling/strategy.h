@@ -95,7 +95,7 @@ struct Strategy {
   // estimator): at a diffuse vertex whose continuation would be segment D or
   // later (the camera ray is segment 0), before the continuation is drawn, the
   // path goes on with probability min(1, largest component of throughput *
-  // albedo), its throughput divided by that (leaf::russian_roulette).
+  // albedo), its throughput divided by that (leaf::roulette_survives).
   int roulette_depth = 0;
   // `+rr:guided` (a strategy with the guided technique): Russian roulette by
   // the light the guide learned (after Vorba and Krivanek's adjoint-driven
@@ -149,6 +149,13 @@ struct Strategy {
 // strategy as it is. Wherever a strategy meets its scene (a render, the
 // viewer, bench, a reference), so that what is reported is what ran.
 Strategy for_scene(const Strategy& strategy, const Scene& scene);
+
+// Whether +rr:guided holds in `strategy` where it is `wanted`: it needs a
+// roulette and the guided technique (a sweep's member at w = 1 has none, and
+// the viewer's box outlives a change of technique).
+inline bool guided_roulette_holds(const Strategy& strategy, bool wanted) {
+  return wanted && strategy.roulette_depth > 0 && strategy.uses(Technique::Guided);
+}
 
 // `strategy` with Russian roulette from `depth` on (the command lines' --rr);
 // depth 0 leaves it as it is.
