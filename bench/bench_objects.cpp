@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
       for (const Quad& q : flat.quads) emitters += flat.materials[q.material].type == MaterialType::DiffuseLight;
       for (const Sphere& s : flat.spheres) emitters += flat.materials[s.material].type == MaterialType::DiffuseLight;
       std::printf("| %s | %zu | %d | %.2f | %.2f | %.2f | %zu | %s |\n", strategy.c_str(), objects, emitters, flat_us,
-                  tree_us, flat_us / tree_us, tree.bvh.nodes.size(), same ? "yes" : "NO");
+                  tree_us, flat_us / tree_us, tree.bvh.wide.size(), same ? "yes" : "NO");
       std::fflush(stdout);
       flat_series.x.push_back(static_cast<double>(objects));
       flat_series.y.push_back(flat_us);

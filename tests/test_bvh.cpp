@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -216,7 +217,7 @@ TEST(Bvh, FindsTheFlatLoopsNearestHitOnTroublingRays) {
   const Scene flat = cluttered_scene(BvhUse::Never), tree = cluttered_scene(BvhUse::Always);
   ASSERT_TRUE(flat.bvh.empty());
   ASSERT_TRUE(tree.bvh.covers(tree.quads.size(), tree.spheres.size()));
-  ASSERT_GT(tree.bvh.nodes.size(), 50u);
+  ASSERT_GT(tree.bvh.wide.size(), 20u);
   const std::vector<TracedRay> rays = troubling_rays(flat, 20000, 11);
   Tally t;
     expect_same_hits(flat, tree, rays, t);
@@ -240,11 +241,65 @@ TEST(Bvh, FindsTheFlatLoopsNearestHitInTheObjectRoom) {
   EXPECT_GT(t.hits, 8000);
 }
 
+// The objects whose boxes are a large part of the scene's are set aside and
+// tested first: the generated room's five walls and none of its small
+// objects; in the cluttered scene, the six slivers 2e-6 radians from parallel,
+// whose margins (growing with the skew) make their boxes far larger than the
+// room. A scene of large objects only has no nodes and still finds the flat
+// loop's hits.
+TEST(Bvh, TheLargeObjectsAreTestedFirst) {
+  const Scene room = object_room(400, 1, BvhUse::Always);
+  EXPECT_EQ(room.bvh.large, (std::vector<std::int32_t>{0, 1, 2, 3, 4}));
+  const Scene cluttered = cluttered_scene(BvhUse::Always);
+  EXPECT_EQ(cluttered.bvh.large, (std::vector<std::int32_t>{126, 128, 130, 132, 134, 136}));
+
+  Scene only[2];
+  for (int k = 0; k < 2; ++k) {
+    only[k].materials.push_back(Material{});
+    only[k].material_names.push_back("white");
+    only[k].quads.push_back(make_quad({555, 0, 0}, {0, 0, 555}, {0, 555, 0}, 0));
+    only[k].quads.push_back(make_quad({0, 0, 555}, {555, 0, 0}, {0, 0, -555}, 0));
+    only[k].quads.push_back(make_quad({0, 0, 555}, {555, 0, 0}, {0, 0, -555}, 0));  // the floor twice
+    only[k].spheres.push_back(Sphere{{300, 200, 250}, 200.0f, 0});
+    only[k].bvh_use = k == 0 ? BvhUse::Never : BvhUse::Always;
+    only[k].prepare();
+  }
+  ASSERT_TRUE(only[1].bvh.wide.empty());
+  ASSERT_EQ(only[1].bvh.large.size(), 4u);
+  ASSERT_TRUE(only[1].bvh.covers(3, 1));
+  Tally t;
+  expect_same_hits(only[0], only[1], troubling_rays(only[0], 3000, 21), t);
+  EXPECT_GT(t.hits, 2000);
+  EXPECT_GT(t.ties, 100);
+}
+
 // The deepest leaf's depth (the root's is 1).
 int tree_depth(const Bvh& bvh, std::int32_t at = 0) {
-  const BvhNode& node = bvh.nodes[static_cast<std::size_t>(at)];
-  if (node.count) return 1;
-  return 1 + std::max(tree_depth(bvh, at + 1), tree_depth(bvh, node.index));
+  const WideBvhNode& node = bvh.wide[static_cast<std::size_t>(at)];
+  int deepest = 1;
+  for (int k = 0; k < WideBvhNode::kWidth; ++k)
+    if ((node.valid >> k & 1u) && node.count[k] == 0) deepest = std::max(deepest, 1 + tree_depth(bvh, node.child[k]));
+  return deepest;
+}
+
+// Every child's box holds its own children's boxes, the invalid children
+// come last, and a node has at least two children (the root of a one-leaf
+// tree excepted).
+void expect_nested_boxes(const Bvh& bvh, std::int32_t at = 0) {
+  const WideBvhNode& node = bvh.wide[static_cast<std::size_t>(at)];
+  const int children = std::popcount(static_cast<unsigned>(node.valid));
+  EXPECT_EQ(node.valid, (1u << children) - 1u);
+  EXPECT_TRUE(children >= 2 || (at == 0 && children == 1));
+  for (int k = 0; k < children; ++k) {
+    if (node.count[k]) continue;
+    const WideBvhNode& inner = bvh.wide[static_cast<std::size_t>(node.child[k])];
+    for (int j = 0; j < std::popcount(static_cast<unsigned>(inner.valid)); ++j)
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(node.lo[a][k], inner.lo[a][j]);
+        EXPECT_GE(node.hi[a][k], inner.hi[a][j]);
+      }
+    expect_nested_boxes(bvh, node.child[k]);
+  }
 }
 
 // Degenerate scenes: every object at one point (every hit a tie: the first
@@ -285,16 +340,23 @@ TEST(Bvh, DegenerateScenes) {
     }
     const Bvh& bvh = scenes[1].bvh;
     ASSERT_FALSE(bvh.empty());
-    EXPECT_EQ(bvh.objects.size(), scenes[1].quads.size() + scenes[1].spheres.size());
-    // Every object is in one leaf, no leaf is over-full, no walk deeper than its stack.
-    std::vector<int> seen(bvh.objects.size(), 0);
-    for (const BvhNode& node : bvh.nodes) {
-      EXPECT_LE(node.count, Bvh::kMaxLeaf);
-      for (int k = 0; k < node.count; ++k) ++seen[static_cast<std::size_t>(bvh.objects[static_cast<std::size_t>(node.index + k)])];
-    }
+    const std::size_t count = scenes[1].quads.size() + scenes[1].spheres.size();
+    ASSERT_EQ(bvh.objects.size() + bvh.large.size(), count);
+    EXPECT_LE(bvh.large.size(), static_cast<std::size_t>(Bvh::kMaxLarge));
+    // Every object is in one leaf or among the large ones, no leaf is
+    // over-full, no walk deeper than its stack.
+    std::vector<int> seen(count, 0);
+    for (const WideBvhNode& node : bvh.wide)
+      for (int k = 0; k < WideBvhNode::kWidth; ++k) {
+        EXPECT_LE(node.count[k], Bvh::kMaxLeaf);
+        for (int j = 0; j < node.count[k]; ++j)
+          ++seen[static_cast<std::size_t>(bvh.objects[static_cast<std::size_t>(node.child[k] + j)])];
+      }
+    for (const std::int32_t object : bvh.large) ++seen[static_cast<std::size_t>(object)];
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(seen.size()));
     EXPECT_LE(tree_depth(bvh), Bvh::kMaxDepth);
-    std::printf("%s: %zu nodes, depth %d\n", names[which], bvh.nodes.size(), tree_depth(bvh));
+    expect_nested_boxes(bvh);
+    std::printf("%s: %zu nodes, depth %d\n", names[which], bvh.wide.size(), tree_depth(bvh));
     std::vector<TracedRay> rays = which == 3 ? std::vector<TracedRay>{} : troubling_rays(scenes[0], 4000, 13);
     Rng rng(8, 8);
     for (int i = 0; i < 2000; ++i) {  // at the point, or at a tiny object

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <utility>
 
 namespace pdflab {
 
@@ -36,6 +37,15 @@ struct Box {
   }
 };
 
+// A node of the binary tree the build makes first (then made wide).
+struct BvhNode {
+  float lo[3], hi[3];  // the box (of the objects' widened boxes)
+  // A leaf: its objects are objects[index .. index + count). Interior
+  // (count 0): its children are the next node and node `index`.
+  std::int32_t index = 0;
+  std::int32_t count = 0;
+};
+
 struct Item {
   Box box;      // widened
   Vec3 centre;  // of the object's own box
@@ -52,30 +62,30 @@ constexpr double kTraversalCost = 1.0;
 
 class Builder {
  public:
-  Builder(std::vector<Item>& items, Bvh& bvh) : items_(items), bvh_(bvh) {}
+  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes, std::vector<std::int32_t>& objects)
+      : items_(items), nodes_(nodes), objects_(objects) {}
 
   std::int32_t build(int begin, int end, int depth) {
-    const auto at = static_cast<std::int32_t>(bvh_.nodes.size());
-    bvh_.nodes.emplace_back();
+    const auto at = static_cast<std::int32_t>(nodes_.size());
+    nodes_.emplace_back();
     Box box, centres;
     for (int i = begin; i < end; ++i) {
       box.grow(items_[static_cast<std::size_t>(i)].box);
       centres.grow(items_[static_cast<std::size_t>(i)].centre);
     }
     const int n = end - begin;
-    int middle = -1, axis = 0;
-    if (n > 1) choose_split(begin, end, depth, box, centres, middle, axis);
+    int middle = -1;
+    if (n > 1) choose_split(begin, end, depth, box, centres, middle);
     if (middle < 0) {
       make_leaf(at, box, begin, end);
       return at;
     }
     build(begin, middle, depth + 1);  // the next node
     const std::int32_t second = build(middle, end, depth + 1);
-    BvhNode& node = bvh_.nodes[static_cast<std::size_t>(at)];
+    BvhNode& node = nodes_[static_cast<std::size_t>(at)];
     set_box(node, box);
     node.index = second;
     node.count = 0;
-    node.axis = static_cast<std::uint8_t>(axis);
     return at;
   }
 
@@ -85,11 +95,11 @@ class Builder {
   }
 
   void make_leaf(std::int32_t at, const Box& box, int begin, int end) {
-    BvhNode& node = bvh_.nodes[static_cast<std::size_t>(at)];
+    BvhNode& node = nodes_[static_cast<std::size_t>(at)];
     set_box(node, box);
-    node.index = static_cast<std::int32_t>(bvh_.objects.size());
-    node.count = static_cast<std::uint16_t>(end - begin);
-    for (int i = begin; i < end; ++i) bvh_.objects.push_back(items_[static_cast<std::size_t>(i)].object);
+    node.index = static_cast<std::int32_t>(objects_.size());
+    node.count = end - begin;
+    for (int i = begin; i < end; ++i) objects_.push_back(items_[static_cast<std::size_t>(i)].object);
   }
 
   // In double, and clamped before it becomes an int: centres near float's
@@ -105,7 +115,7 @@ class Builder {
 
   // Where to split [begin, end) (`middle`, the items reordered), or -1: a
   // leaf is cheaper and small enough.
-  void choose_split(int begin, int end, int depth, const Box& box, const Box& centres, int& middle, int& axis) {
+  void choose_split(int begin, int end, int depth, const Box& box, const Box& centres, int& middle) {
     const int n = end - begin;
     double best_cost = kInf;
     int best_axis = -1, best_split = 0;
@@ -148,7 +158,7 @@ class Builder {
     if (n <= Bvh::kMaxLeaf && !(split_cost < static_cast<double>(n))) return;  // a leaf
     if (best_axis < 0) {
       // The centres coincide, or the tree is deep: halves by count, along the widest spread of centres.
-      axis = 0;
+      int axis = 0;
       for (int a = 1; a < 3; ++a)
         if (spread(centres, a) > spread(centres, axis)) axis = a;
       middle = begin + n / 2;
@@ -158,7 +168,7 @@ class Builder {
       });
       return;
     }
-    axis = best_axis;
+    const int axis = best_axis;
     const float lo = centres.lo[axis];
     const double extent = spread(centres, axis);
     const auto split = std::partition(items_.begin() + begin, items_.begin() + end,
@@ -167,8 +177,86 @@ class Builder {
   }
 
   std::vector<Item>& items_;
-  Bvh& bvh_;
+  std::vector<BvhNode>& nodes_;
+  std::vector<std::int32_t>& objects_;
 };
+
+// Moves the objects whose boxes are at least Bvh::kLargeShare of the scene's
+// area (at most Bvh::kMaxLarge of them, the largest, the lower number first
+// among equals) from `items` to `large`, by increasing number.
+void set_aside_large(std::vector<Item>& items, std::vector<std::int32_t>& large) {
+  Box scene;
+  for (const Item& item : items) scene.grow(item.box);
+  const double least = Bvh::kLargeShare * scene.half_area();
+  std::vector<std::pair<double, std::int32_t>> candidates;
+  for (const Item& item : items) {
+    const double area = item.box.half_area();
+    if (area >= least && area > 0.0) candidates.emplace_back(-area, item.object);
+  }
+  if (candidates.size() > static_cast<std::size_t>(Bvh::kMaxLarge)) {
+    std::nth_element(candidates.begin(), candidates.begin() + Bvh::kMaxLarge, candidates.end());
+    candidates.resize(Bvh::kMaxLarge);
+  }
+  for (const auto& c : candidates) large.push_back(c.second);
+  std::sort(large.begin(), large.end());
+  items.erase(std::remove_if(items.begin(), items.end(),
+                             [&](const Item& item) { return std::binary_search(large.begin(), large.end(), item.object); }),
+              items.end());
+}
+
+double half_area(const BvhNode& node) {
+  Box box;
+  box.lo = Vec3(node.lo[0], node.lo[1], node.lo[2]);
+  box.hi = Vec3(node.hi[0], node.hi[1], node.hi[2]);
+  return box.half_area();
+}
+
+// The wide node for the binary node `at` (and, below it, those for its
+// descendants): its children are the binary node's, each interior one of
+// largest area opened into its own two while there are fewer than eight.
+// Returns its index in bvh.wide.
+std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at) {
+  const auto index = static_cast<std::int32_t>(bvh.wide.size());
+  bvh.wide.emplace_back();
+  std::int32_t kids[WideBvhNode::kWidth];
+  int n = 0;
+  const BvhNode& top = nodes[static_cast<std::size_t>(at)];
+  if (top.count) {
+    kids[n++] = at;  // a tree of one leaf
+  } else {
+    kids[n++] = at + 1;
+    kids[n++] = top.index;
+  }
+  while (n < WideBvhNode::kWidth) {
+    int open = -1;
+    for (int k = 0; k < n; ++k) {
+      const BvhNode& kid = nodes[static_cast<std::size_t>(kids[k])];
+      if (!kid.count && (open < 0 || half_area(kid) > half_area(nodes[static_cast<std::size_t>(kids[open])])))
+        open = k;
+    }
+    if (open < 0) break;
+    const BvhNode& opened = nodes[static_cast<std::size_t>(kids[open])];
+    kids[n++] = opened.index;
+    kids[open] = kids[open] + 1;
+  }
+  WideBvhNode node;
+  for (int a = 0; a < 3; ++a)
+    for (int k = 0; k < WideBvhNode::kWidth; ++k) node.lo[a][k] = kInf, node.hi[a][k] = -kInf;
+  for (int k = 0; k < WideBvhNode::kWidth; ++k) node.child[k] = -1, node.count[k] = 0;
+  for (int k = 0; k < n; ++k) {
+    const BvhNode kid = nodes[static_cast<std::size_t>(kids[k])];
+    for (int a = 0; a < 3; ++a) node.lo[a][k] = kid.lo[a], node.hi[a][k] = kid.hi[a];
+    node.valid = static_cast<std::uint8_t>(node.valid | (1u << k));
+    if (kid.count) {
+      node.child[k] = kid.index;
+      node.count[k] = static_cast<std::uint8_t>(kid.count);
+    } else {
+      node.child[k] = widen(bvh, nodes, kids[k]);
+    }
+  }
+  bvh.wide[static_cast<std::size_t>(index)] = node;
+  return index;
+}
 
 }  // namespace
 
@@ -198,10 +286,14 @@ Bvh Bvh::build(const std::vector<Quad>& quads, const std::vector<Sphere>& sphere
     const Vec3 reach(s.radius + object_margin(s, scale));
     items.push_back({{s.center - reach, s.center + reach}, s.center, static_cast<std::int32_t>(items.size())});
   }
+  set_aside_large(items, bvh.large);
   if (items.empty()) return bvh;
-  bvh.nodes.reserve(2 * items.size());
+  std::vector<BvhNode> nodes;
+  nodes.reserve(2 * items.size());
   bvh.objects.reserve(items.size());
-  Builder(items, bvh).build(0, static_cast<int>(items.size()), 0);
+  Builder(items, nodes, bvh.objects).build(0, static_cast<int>(items.size()), 0);
+  bvh.wide.reserve(nodes.size() / 4 + 1);
+  widen(bvh, nodes, 0);
   return bvh;
 }
 
