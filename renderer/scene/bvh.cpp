@@ -55,8 +55,10 @@ struct Item {
 constexpr int kBins = 16;
 // Below this depth the heuristic chooses the splits; from it on the objects
 // are halved by count, so no tree is deeper than Bvh::kMaxDepth for up to
-// kMaxLeaf * 2^(kMaxDepth - kHeuristicDepth - 1) objects.
-constexpr int kHeuristicDepth = 40;
+// kMaxLeaf * 2^(kMaxDepth - kHeuristicDepth - 1) objects: 2^31, more than a
+// scene can number.
+constexpr int kHeuristicDepth = 32;
+static_assert(Bvh::kMaxLeaf * (std::int64_t{1} << (Bvh::kMaxDepth - kHeuristicDepth - 1)) >= INT32_MAX);
 // A node's cost against a leaf's: one box test against one object test.
 constexpr double kTraversalCost = 1.0;
 

@@ -17,7 +17,11 @@
 #include "renderer/math.h"
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace pdflab {
 
@@ -92,10 +96,8 @@ struct Bvh {
   template <class Test>
   void walk(const Vec3& origin, const Vec3& direction, const float& best_t, Test test) const;
 
-  // Whether the walk reaches child k's box (a slab test) at a distance in
-  // [0, limit], and from which distance (`near`).
-  static bool reaches(const WideBvhNode& node, int k, const Vec3& origin, const Vec3& inverse, float limit, float& near);
 };
+static_assert(Bvh::kMaxLeaf <= 255, "a wide node counts a leaf's objects in a byte");
 
 // How much an object's box is widened on every side: float's error in the
 // intersection tests, bounded for rays whose origin and distance are within
@@ -108,33 +110,15 @@ namespace bvh_walk {
 #include "renderer/scene/bvh_walk.inc"
 }  // namespace bvh_walk
 
-inline bool Bvh::reaches(const WideBvhNode& node, int k, const Vec3& origin, const Vec3& inverse, float limit,
-                         float& near) {
-  float far = limit;
-  near = 0.0f;
-  for (int a = 0; a < 3; ++a) {
-    const float t0 = (node.lo[a][k] - origin[a]) * inverse[a];
-    const float t1 = (node.hi[a][k] - origin[a]) * inverse[a];
-    // A NaN (an origin on a box's face, parallel to it) constrains nothing:
-    // the widened boxes hold every reported hit strictly inside.
-    const float lo = t0 < t1 ? t0 : t1, hi = t0 < t1 ? t1 : t0;
-    near = lo > near ? lo : near;
-    far = hi < far ? hi : far;
-  }
-  return near <= far;
-}
-
 template <class Test>
 void Bvh::walk(const Vec3& origin, const Vec3& direction, const float& best_t, Test test) const {
   for (const std::int32_t object : large) test(object);
-  const Vec3 inverse(1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z);
+  const float from[3] = {origin.x, origin.y, origin.z};
+  const float inverse[3] = {1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z};
   bvh_walk::walk_tree(
       *this, [&] { return best_t; },
       [&](const WideBvhNode& node, float limit, float* near) {
-        unsigned bits = 0;
-        for (int k = 0; k < WideBvhNode::kWidth; ++k)
-          if ((node.valid >> k & 1u) && reaches(node, k, origin, inverse, limit, near[k])) bits |= 1u << k;
-        return bits;
+        return bvh_walk::reach_eight(node, from, inverse, limit, near);
       },
       test);
 }
