@@ -1,7 +1,8 @@
 #pragma once
 // A bounding volume hierarchy over a scene's objects (its quads and spheres),
-// for scenes with many of them: a binned surface-area-heuristic build into a
-// flat array of nodes, walked nearest child first. The book's scenes have a
+// for scenes with many of them: its large objects set aside, the rest a
+// binned surface-area-heuristic tree of eight children a node, walked one ray
+// at a time, nearest child first (bvh_walk.inc). The book's scenes have a
 // dozen objects, which the flat arrays test faster than any tree:
 // Scene::prepare builds one only from kBvhObjectThreshold objects on.
 //
@@ -67,7 +68,7 @@ struct Bvh {
   // would widen every node above it to most of the scene, and most rays would
   // walk down to it through nodes they need for nothing else; tested first,
   // it gives most rays a near hit that cuts the walk short. On the many-lights
-  // room: 20 of 526 objects, 23% less time (docs/many_lights.md).
+  // room: 20 of 526 objects, 12% less time (docs/many_lights.md).
   static constexpr double kLargeShare = 1.0 / 128;
   static constexpr int kMaxLarge = 32;
 
@@ -115,12 +116,7 @@ void Bvh::walk(const Vec3& origin, const Vec3& direction, const float& best_t, T
   for (const std::int32_t object : large) test(object);
   const float from[3] = {origin.x, origin.y, origin.z};
   const float inverse[3] = {1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z};
-  bvh_walk::walk_tree(
-      *this, [&] { return best_t; },
-      [&](const WideBvhNode& node, float limit, float* near) {
-        return bvh_walk::reach_eight(node, from, inverse, limit, near);
-      },
-      test);
+  bvh_walk::walk_tree(*this, from, inverse, [&] { return best_t; }, test);
 }
 
 }  // namespace pdflab
