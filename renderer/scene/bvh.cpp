@@ -39,7 +39,7 @@ struct Box {
 
 // A node of the binary tree the build makes first (then made wide).
 struct BvhNode {
-  float lo[3], hi[3];  // the box (of the objects' widened boxes)
+  Box box;  // of the objects' widened boxes
   // A leaf: its objects are objects[index .. index + count). Interior
   // (count 0): its children are the next node and node `index`.
   std::int32_t index = 0;
@@ -85,20 +85,16 @@ class Builder {
     build(begin, middle, depth + 1);  // the next node
     const std::int32_t second = build(middle, end, depth + 1);
     BvhNode& node = nodes_[static_cast<std::size_t>(at)];
-    set_box(node, box);
+    node.box = box;
     node.index = second;
     node.count = 0;
     return at;
   }
 
  private:
-  static void set_box(BvhNode& node, const Box& box) {
-    for (int a = 0; a < 3; ++a) node.lo[a] = box.lo[a], node.hi[a] = box.hi[a];
-  }
-
   void make_leaf(std::int32_t at, const Box& box, int begin, int end) {
     BvhNode& node = nodes_[static_cast<std::size_t>(at)];
-    set_box(node, box);
+    node.box = box;
     node.index = static_cast<std::int32_t>(objects_.size());
     node.count = end - begin;
     for (int i = begin; i < end; ++i) objects_.push_back(items_[static_cast<std::size_t>(i)].object);
@@ -206,13 +202,6 @@ void set_aside_large(std::vector<Item>& items, std::vector<std::int32_t>& large)
               items.end());
 }
 
-double half_area(const BvhNode& node) {
-  Box box;
-  box.lo = Vec3(node.lo[0], node.lo[1], node.lo[2]);
-  box.hi = Vec3(node.hi[0], node.hi[1], node.hi[2]);
-  return box.half_area();
-}
-
 // The wide node for the binary node `at` (and, below it, those for its
 // descendants): its children are the binary node's, each interior one of
 // largest area opened into its own two while there are fewer than eight.
@@ -233,7 +222,7 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
     int open = -1;
     for (int k = 0; k < n; ++k) {
       const BvhNode& kid = nodes[static_cast<std::size_t>(kids[k])];
-      if (!kid.count && (open < 0 || half_area(kid) > half_area(nodes[static_cast<std::size_t>(kids[open])])))
+      if (!kid.count && (open < 0 || kid.box.half_area() > nodes[static_cast<std::size_t>(kids[open])].box.half_area()))
         open = k;
     }
     if (open < 0) break;
@@ -247,7 +236,7 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
   for (int k = 0; k < WideBvhNode::kWidth; ++k) node.child[k] = -1, node.count[k] = 0;
   for (int k = 0; k < n; ++k) {
     const BvhNode kid = nodes[static_cast<std::size_t>(kids[k])];
-    for (int a = 0; a < 3; ++a) node.lo[a][k] = kid.lo[a], node.hi[a][k] = kid.hi[a];
+    for (int a = 0; a < 3; ++a) node.lo[a][k] = kid.box.lo[a], node.hi[a][k] = kid.box.hi[a];
     node.valid = static_cast<std::uint8_t>(node.valid | (1u << k));
     if (kid.count) {
       node.child[k] = kid.index;
