@@ -93,10 +93,7 @@ int run_reference(const ReferenceOptions& o) {
   if (o.max_depth != 0) scene->max_depth = o.max_depth;
   check_image_size(scene->camera.width, scene->camera.height, "--width/--height");
   scene->prepare();
-  const Strategy strategy = for_scene(
-      with_roulette(o.strategy.empty() ? default_reference_strategy(*scene) : Strategy::parse(o.strategy),
-                    o.roulette_depth),
-      *scene);
+  const Strategy strategy = reference_strategy(o.strategy, o.roulette_depth, *scene);
   const std::string cache_dir = reference_cache_dir(o.cache_dir);
   check_cache_dir(cache_dir);  // before the render, not after it
   const ReferenceKey key = reference_key(*scene);

@@ -14,7 +14,7 @@ struct ReferenceOptions {
   std::uint32_t spp = 0;      // exactly one of spp, seconds, target_relmse
   double seconds = 0.0;
   double target_relmse = 0.0;
-  std::string strategy;  // empty: default_reference_strategy
+  std::string strategy;  // empty: default_reference_strategy (reference_strategy)
   int roulette_depth = 0;  // --rr: Russian roulette from this depth on in every strategy (0: as given)
   std::uint32_t seed_stream = 0;
   std::string out;        // optional: also written here

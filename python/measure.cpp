@@ -152,9 +152,7 @@ class ReferenceBuildHandle {
     ReferenceJob job;
     job.scene = scene;
     job.scene_file = handle.origin;
-    job.strategy = for_scene(
-        with_roulette(strategy.empty() ? default_reference_strategy(*scene) : Strategy::parse(strategy), roulette_depth),
-        *scene);
+    job.strategy = reference_strategy(strategy, roulette_depth, *scene);
     job.seed_stream = static_cast<std::uint32_t>(seed_stream);
     job.goal = {spp ? static_cast<std::uint32_t>(*spp) : 0u, seconds.value_or(0.0), target_relmse.value_or(0.0)};
     job.threads = threads;

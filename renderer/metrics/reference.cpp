@@ -304,6 +304,11 @@ Strategy default_reference_strategy(const Scene& scene) {
   }
 }
 
+Strategy reference_strategy(const std::string& text, int roulette_depth, const Scene& scene) {
+  return for_scene(with_roulette(text.empty() ? default_reference_strategy(scene) : Strategy::parse(text), roulette_depth),
+                   scene);
+}
+
 std::string reference_cache_dir(const std::string& option) {
   if (!option.empty()) return option;
   if (const char* env = std::getenv("PDFLAB_REFERENCE_CACHE"); env && *env) return env;

@@ -111,6 +111,12 @@ std::string shared_random_numbers(const ReferenceInfo& reference, std::uint64_t 
 // map is nee-mis's light sample too: docs/environment.md).
 Strategy default_reference_strategy(const Scene& scene);
 
+// The strategy a reference of `scene` is made with: `text` (empty: the
+// default above), with Russian roulette from `roulette_depth` where that is
+// given (with_roulette), as it runs on the scene (for_scene). `pdflab
+// reference` and the Python module's reference() both take it.
+Strategy reference_strategy(const std::string& text, int roulette_depth, const Scene& scene);
+
 // The cache -------------------------------------------------------------------
 
 // `option` when not empty, else $PDFLAB_REFERENCE_CACHE, else
