@@ -40,10 +40,10 @@ struct Box {
 // A node of the binary tree the build makes first (then made wide).
 struct BvhNode {
   Box box;  // of the objects' widened boxes
-  // A leaf: its objects are objects[index .. index + count). Interior
-  // (count 0): its children are the next node and node `index`.
+  // A leaf: its one object is `index`. Interior: its children are the next
+  // node and node `index`.
   std::int32_t index = 0;
-  std::int32_t count = 0;
+  bool leaf = false;
 };
 
 struct Item {
@@ -55,17 +55,14 @@ struct Item {
 constexpr int kBins = 16;
 // Below this depth the heuristic chooses the splits; from it on the objects
 // are halved by count, so no tree is deeper than Bvh::kMaxDepth for up to
-// kMaxLeaf * 2^(kMaxDepth - kHeuristicDepth - 1) objects: 2^31, more than a
-// scene can number.
+// 2^(kMaxDepth - kHeuristicDepth - 1) objects (a leaf is one): 2^31, more
+// than a scene can number.
 constexpr int kHeuristicDepth = 32;
-static_assert(Bvh::kMaxLeaf * (std::int64_t{1} << (Bvh::kMaxDepth - kHeuristicDepth - 1)) >= INT32_MAX);
-// A node's cost against a leaf's: one box test against one object test.
-constexpr double kTraversalCost = 1.0;
+static_assert((std::int64_t{1} << (Bvh::kMaxDepth - kHeuristicDepth - 1)) >= INT32_MAX);
 
 class Builder {
  public:
-  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes, std::vector<std::int32_t>& objects)
-      : items_(items), nodes_(nodes), objects_(objects) {}
+  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes) : items_(items), nodes_(nodes) {}
 
   std::int32_t build(int begin, int end, int depth) {
     const auto at = static_cast<std::int32_t>(nodes_.size());
@@ -77,9 +74,12 @@ class Builder {
     }
     const int n = end - begin;
     int middle = -1;
-    if (n > 1) choose_split(begin, end, depth, box, centres, middle);
+    if (n > 1) choose_split(begin, end, depth, centres, middle);
     if (middle < 0) {
-      make_leaf(at, box, begin, end);
+      BvhNode& leaf = nodes_[static_cast<std::size_t>(at)];
+      leaf.box = box;
+      leaf.index = items_[static_cast<std::size_t>(begin)].object;
+      leaf.leaf = true;
       return at;
     }
     build(begin, middle, depth + 1);  // the next node
@@ -87,19 +87,10 @@ class Builder {
     BvhNode& node = nodes_[static_cast<std::size_t>(at)];
     node.box = box;
     node.index = second;
-    node.count = 0;
     return at;
   }
 
  private:
-  void make_leaf(std::int32_t at, const Box& box, int begin, int end) {
-    BvhNode& node = nodes_[static_cast<std::size_t>(at)];
-    node.box = box;
-    node.index = static_cast<std::int32_t>(objects_.size());
-    node.count = end - begin;
-    for (int i = begin; i < end; ++i) objects_.push_back(items_[static_cast<std::size_t>(i)].object);
-  }
-
   // In double, and clamped before it becomes an int: centres near float's
   // largest values would overflow float's differences (and a NaN or an
   // infinity turned into an int is undefined).
@@ -111,9 +102,8 @@ class Builder {
     return static_cast<double>(centres.hi[axis]) - centres.lo[axis];
   }
 
-  // Where to split [begin, end) (`middle`, the items reordered), or -1: a
-  // leaf is cheaper and small enough.
-  void choose_split(int begin, int end, int depth, const Box& box, const Box& centres, int& middle) {
+  // Where to split [begin, end), two objects or more (`middle`, the items reordered).
+  void choose_split(int begin, int end, int depth, const Box& centres, int& middle) {
     const int n = end - begin;
     double best_cost = kInf;
     int best_axis = -1, best_split = 0;
@@ -151,9 +141,6 @@ class Builder {
         }
       }
     }
-    const double area = box.half_area();
-    const double split_cost = area > 0.0 ? kTraversalCost + best_cost / area : kInf;
-    if (n <= Bvh::kMaxLeaf && !(split_cost < static_cast<double>(n))) return;  // a leaf
     if (best_axis < 0) {
       // The centres coincide, or the tree is deep: halves by count, along the widest spread of centres.
       int axis = 0;
@@ -176,7 +163,6 @@ class Builder {
 
   std::vector<Item>& items_;
   std::vector<BvhNode>& nodes_;
-  std::vector<std::int32_t>& objects_;
 };
 
 // Moves the objects whose boxes are at least Bvh::kLargeShare of the scene's
@@ -212,7 +198,7 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
   std::int32_t kids[WideBvhNode::kWidth];
   int n = 0;
   const BvhNode& top = nodes[static_cast<std::size_t>(at)];
-  if (top.count) {
+  if (top.leaf) {
     kids[n++] = at;  // a tree of one leaf
   } else {
     kids[n++] = at + 1;
@@ -222,7 +208,7 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
     int open = -1;
     for (int k = 0; k < n; ++k) {
       const BvhNode& kid = nodes[static_cast<std::size_t>(kids[k])];
-      if (!kid.count && (open < 0 || kid.box.half_area() > nodes[static_cast<std::size_t>(kids[open])].box.half_area()))
+      if (!kid.leaf && (open < 0 || kid.box.half_area() > nodes[static_cast<std::size_t>(kids[open])].box.half_area()))
         open = k;
     }
     if (open < 0) break;
@@ -233,17 +219,12 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
   WideBvhNode node;
   for (int a = 0; a < 3; ++a)
     for (int k = 0; k < WideBvhNode::kWidth; ++k) node.lo[a][k] = kInf, node.hi[a][k] = -kInf;
-  for (int k = 0; k < WideBvhNode::kWidth; ++k) node.child[k] = -1, node.count[k] = 0;
+  for (int k = 0; k < WideBvhNode::kWidth; ++k) node.child[k] = WideBvhNode::leaf(0);
   for (int k = 0; k < n; ++k) {
     const BvhNode kid = nodes[static_cast<std::size_t>(kids[k])];
     for (int a = 0; a < 3; ++a) node.lo[a][k] = kid.box.lo[a], node.hi[a][k] = kid.box.hi[a];
     node.valid = static_cast<std::uint8_t>(node.valid | (1u << k));
-    if (kid.count) {
-      node.child[k] = kid.index;
-      node.count[k] = static_cast<std::uint8_t>(kid.count);
-    } else {
-      node.child[k] = widen(bvh, nodes, kids[k]);
-    }
+    node.child[k] = kid.leaf ? WideBvhNode::leaf(kid.index) : widen(bvh, nodes, kids[k]);
   }
   bvh.wide[static_cast<std::size_t>(index)] = node;
   return index;
@@ -281,8 +262,7 @@ Bvh Bvh::build(const std::vector<Quad>& quads, const std::vector<Sphere>& sphere
   if (items.empty()) return bvh;
   std::vector<BvhNode> nodes;
   nodes.reserve(2 * items.size());
-  bvh.objects.reserve(items.size());
-  Builder(items, nodes, bvh.objects).build(0, static_cast<int>(items.size()), 0);
+  Builder(items, nodes).build(0, static_cast<int>(items.size()), 0);
   bvh.wide.reserve(nodes.size() / 4 + 1);
   widen(bvh, nodes, 0);
   return bvh;

@@ -47,20 +47,22 @@ enum class BvhUse : std::uint8_t { Auto, Always, Never };
 struct alignas(64) WideBvhNode {
   static constexpr int kWidth = 8;
   float lo[3][kWidth], hi[3][kWidth];  // child k's box: lo[axis][k] .. hi[axis][k]
-  // An interior child: the node's index in Bvh::wide (count 0); a leaf: its
-  // objects are Bvh::objects[child .. child + count).
+  // An interior child: the node's index in Bvh::wide; a leaf (negative): its
+  // one object, leaf_object(child[k]).
   std::int32_t child[kWidth];
-  std::uint8_t count[kWidth];
   std::uint8_t valid = 0;  // bit k: child k exists (the others' boxes are empty)
+
+  static constexpr std::int32_t leaf(std::int32_t object) { return -1 - object; }
+  static constexpr std::int32_t leaf_object(std::int32_t child) { return -1 - child; }
 };
 
 struct Bvh {
   // The deepest a tree is built (a longer walk falls back to halving by count),
   // so a walk's stack of nodes to visit holds at most this many.
   static constexpr int kMaxDepth = 64;
-  // Objects per leaf at most (where the objects cannot be told apart by their
-  // centres, a leaf still holds no more).
-  static constexpr int kMaxLeaf = 1;
+  // A leaf is one object (where the objects cannot be told apart by their
+  // centres, too): on the many-lights room, leaves of two or four objects took
+  // 9% and 21% more time (docs/many_lights.md).
 
   // Objects whose boxes are a large part of the scene's (a room's walls and
   // floor: from kLargeShare of its area on, the kMaxLarge largest): every
@@ -72,9 +74,8 @@ struct Bvh {
   static constexpr double kLargeShare = 1.0 / 128;
   static constexpr int kMaxLarge = 32;
 
-  // Object numbers in leaf order: quad i is i, sphere j is quads + j (the
-  // numbering of the tracer's hit rows).
-  std::vector<std::int32_t> objects;
+  // Object numbers: quad i is i, sphere j is quads + j (the numbering of the
+  // tracer's hit rows).
   std::vector<std::int32_t> large;  // tested first, by increasing number
   std::vector<WideBvhNode> wide;    // wide[0] is the root; empty: every object is `large`
   int quads = 0, spheres = 0;  // the objects it was built over
@@ -98,7 +99,6 @@ struct Bvh {
   void walk(const Vec3& origin, const Vec3& direction, const float& best_t, Test test) const;
 
 };
-static_assert(Bvh::kMaxLeaf <= 255, "a wide node counts a leaf's objects in a byte");
 
 // How much an object's box is widened on every side: float's error in the
 // intersection tests, bounded for rays whose origin and distance are within
