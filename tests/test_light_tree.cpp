@@ -153,6 +153,30 @@ TEST(LightTree, ChoosesByDistanceAndOrientation) {
   }
 }
 
+// Two spheres of nearly float's largest power, one on each side of the point
+// at the same distance: each child's importance is finite, their sum is not,
+// and the split still gives each half of the numbers (halved before they are
+// added). The root's power, their sum, is infinite and is never used.
+TEST(LightTree, SplitsEvenlyAtFloatsLargestPowers) {
+  std::vector<LightTree::Emitter> emitters;
+  for (const float x : {-1.0f, 1.0f}) {
+    LightTree::Emitter e;
+    e.lo = Vec3(x - 0.1f, -0.1f, -0.1f);
+    e.hi = Vec3(x + 0.1f, 0.1f, 0.1f);
+    e.axis = Vec3(0, 0, 1);
+    e.cos_spread = -1.0f;
+    e.power = 3e38f;
+    emitters.push_back(e);
+  }
+  const LightTree tree(emitters, kLightChoiceFloor);
+  for (const Vec3& normal : {Vec3(0.0f), Vec3(0, 1, 0)}) {
+    const std::vector<float> p = tree.probabilities(Vec3(0.0f), normal);
+    EXPECT_EQ(static_cast<double>(p[0]) + p[1], 1.0);
+    EXPECT_NEAR(p[0], 0.5f, 1e-6f);
+    EXPECT_NEAR(p[1], 0.5f, 1e-6f);
+  }
+}
+
 Scene many_lamps_scene(const char* light_choice) {
   std::string text = R"({"camera": {"width": 8, "height": 8, "vfov": 40, "lookfrom": [0, 1, -9], "lookat": [0, 1, 0]},
     "materials": {"white": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]},
