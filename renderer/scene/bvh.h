@@ -48,7 +48,9 @@ struct alignas(64) WideBvhNode {
   static constexpr int kWidth = 8;
   float lo[3][kWidth], hi[3][kWidth];  // child k's box: lo[axis][k] .. hi[axis][k]
   // An interior child: the node's index in Bvh::wide; a leaf (negative): its
-  // one object, leaf_object(child[k]).
+  // one object, leaf_object(child[k]). A leaf is one object, even where the
+  // objects cannot be told apart by their centres: on the many-lights room,
+  // leaves of two or four objects took 9% and 21% more time.
   std::int32_t child[kWidth];
   std::uint8_t valid = 0;  // bit k: child k exists (the others' boxes are empty)
 
@@ -60,9 +62,6 @@ struct Bvh {
   // The deepest a tree is built (a longer walk falls back to halving by count),
   // so a walk's stack of nodes to visit holds at most this many.
   static constexpr int kMaxDepth = 64;
-  // A leaf is one object (where the objects cannot be told apart by their
-  // centres, too): on the many-lights room, leaves of two or four objects took
-  // 9% and 21% more time (docs/many_lights.md).
 
   // Objects whose boxes are a large part of the scene's (a room's walls and
   // floor: from kLargeShare of its area on, the kMaxLarge largest): every
