@@ -71,7 +71,6 @@ using Double = double;
 PDFLAB_LEAF Double to_double(Float x) { return x; }
 PDFLAB_LEAF Float to_float(Double x) { return static_cast<float>(x); }
 PDFLAB_LEAF Double lane_sqrt(Double x) { return std::sqrt(x); }
-PDFLAB_LEAF Int lane_trunc(Double x) { return static_cast<Int>(x); }
 PDFLAB_LEAF Int lane_int_bits(Float x) { return std::bit_cast<Int>(x); }
 // The 16 floats of row `index` of a table of 64-byte rows.
 PDFLAB_LEAF void lane_rows16(const float* rows, Int index, Float (&field)[16]) {
