@@ -56,6 +56,32 @@ LightTree::LightTree(const std::vector<Emitter>& emitters, float floor_share) : 
   bounds_.emplace_back();
   build(0, order, 0, count_, emitters, 0, 0);
   bounds_ = {};
+  make_pairs();
+  nodes_ = {};
+}
+
+// The build's node at (2p + 1, 2p + 2), the children of a node, as pair p:
+// the root's children are pair 0, and a node whose children are at c, c + 1
+// leads to pair (c - 1) / 2.
+void LightTree::make_pairs() {
+  if (count_ <= 1) return;
+  pairs_.resize((nodes_.size() - 1) / 2);
+  const auto side = [&](const Node& n) {
+    return Side{n.centre, n.radius2, n.radius, n.power, n.child >= 0 ? (n.child - 1) / 2 : -1 - n.light};
+  };
+  for (std::size_t p = 0; p < pairs_.size(); ++p) {
+    const Node& l = nodes_[2 * p + 1];
+    const Node& r = nodes_[2 * p + 2];
+    Pair& pair = pairs_[p];
+    pair.left = side(l);
+    pair.right = side(r);
+    if (l.cos_spread <= -1.0f && r.cos_spread <= -1.0f) continue;
+    pair.cones = static_cast<std::int32_t>(cone_rows_.size());
+    ConeRow c;
+    c.left_axis = l.axis, c.left_cos_spread = l.cos_spread, c.left_sin_spread = l.sin_spread;
+    c.right_axis = r.axis, c.right_cos_spread = r.cos_spread, c.right_sin_spread = r.sin_spread;
+    cone_rows_.push_back(c);
+  }
 }
 
 void LightTree::set_box(int at, const Vec3& lo, const Vec3& hi) {

@@ -71,25 +71,40 @@ class LightTree {
   // The tree's depth (the longest path from the root to an emitter).
   int depth() const;
 
-  // A node as the descent reads it (leaf::tree_descent): one 64-byte row of
-  // 16 floats, so that the packet tracer reads the rows of all its lanes at
-  // once. The sphere around the node's box, its cone and power; the box
-  // itself is the build's alone (bounds_).
-  struct alignas(64) Node {
+  // What the descent reads (leaf::tree_descent): the two children of a node
+  // side by side in one 64-byte row of 16 floats, so that a level of the
+  // packet tracer's descent reads and transposes one row a lane, not two.
+  // Each side: the sphere around the child's box and its power, and where it
+  // leads. Cones are read apart (ConeRow), only where some lane needs one:
+  // a subtree that holds a sphere emits every way and has none.
+  struct Side {
     Vec3 centre;       // of the box
     float radius2;     // the squared half-diagonal of the box: the sphere through its corners
-    Vec3 axis;
-    float cos_spread;  // of the emitters' normals about axis (-1: every direction); each emits up to 90 degrees beyond
-    float sin_spread;  // of the same angle (0 where cos_spread is -1)
     float radius;      // sqrt(radius2)
     float power;
-    std::int32_t child = -1;  // the left child (the right one is child + 1); -1: a leaf
-    std::int32_t light = -1;  // a leaf's emitter
-    float unused[3] = {};
+    std::int32_t link;  // the pair of the child's own children; -1 - emitter for a leaf
+  };
+  struct alignas(64) Pair {
+    Side left;
+    std::int32_t cones = -1;  // the children's ConeRow; -1: neither has a cone (both emit every way)
+    Side right;
+    float unused = 0.0f;
+  };
+  // The cones of a pair's children (cos_spread -1 and sin_spread 0: every direction).
+  struct alignas(64) ConeRow {
+    Vec3 left_axis;
+    float left_cos_spread;  // of the emitters' normals about the axis; each emits up to 90 degrees beyond
+    float left_sin_spread;
+    Vec3 right_axis;
+    float right_cos_spread;
+    float right_sin_spread;
+    float unused[6] = {};
   };
   static constexpr std::uint32_t kChoiceRange = 1u << 24;  // the top 24 bits of the 32-bit number choose
 
-  const Node* nodes() const { return nodes_.data(); }
+  // The root's children are pair 0.
+  const Pair* pairs() const { return pairs_.data(); }
+  const ConeRow* cone_rows() const { return cone_rows_.data(); }
   // Emitter `light`'s path from the root: bit k the side taken at depth k (1: right).
   std::uint64_t path(int light) const { return path_[static_cast<std::size_t>(light)]; }
   // The numbers of the 2^24 each emitter has in the uniform floor.
@@ -101,6 +116,20 @@ class LightTree {
   struct Box {
     Vec3 lo, hi;
   };
+  // A node as the build makes it (the root first, a node's children side by side).
+  struct Node {
+    Vec3 centre;
+    float radius2;
+    Vec3 axis;
+    float cos_spread;  // -1: every direction
+    float sin_spread;  // 0 where cos_spread is -1
+    float radius;
+    float power;
+    std::int32_t child = -1;  // the left child (the right one is child + 1); -1: a leaf
+    std::int32_t light = -1;  // a leaf's emitter
+  };
+  // The descent's rows from the build's nodes.
+  void make_pairs();
   void build(int at, std::vector<int>& order, int begin, int end, const std::vector<Emitter>& emitters,
              std::uint64_t path, int length);
 
@@ -108,7 +137,9 @@ class LightTree {
   // The node's cone, and the sine of its spread beside the cosine.
   static void set_cone(Node& n, const Vec3& axis, float cos_spread);
 
-  std::vector<Node> nodes_;  // the root first
+  std::vector<Node> nodes_;  // the build's; the root first
+  std::vector<Pair> pairs_;
+  std::vector<ConeRow> cone_rows_;
   std::vector<Box> bounds_;  // per node, for the build
   std::vector<std::uint64_t> path_;  // per emitter: bit k is the side taken at depth k (1: right)
   std::vector<std::uint8_t> path_length_;
