@@ -190,7 +190,7 @@ void set_aside_large(std::vector<Item>& items, std::vector<std::int32_t>& large)
 
 // The wide node for the binary node `at` (and, below it, those for its
 // descendants): its children are the binary node's, each interior one of
-// largest area opened into its own two while there are fewer than eight.
+// largest area opened into its own two while there are fewer than sixteen.
 // Returns its index in bvh.wide.
 std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at) {
   const auto index = static_cast<std::int32_t>(bvh.wide.size());
@@ -223,7 +223,8 @@ std::int32_t widen(Bvh& bvh, const std::vector<BvhNode>& nodes, std::int32_t at)
   for (int k = 0; k < n; ++k) {
     const BvhNode kid = nodes[static_cast<std::size_t>(kids[k])];
     for (int a = 0; a < 3; ++a) node.lo[a][k] = kid.box.lo[a], node.hi[a][k] = kid.box.hi[a];
-    node.valid = static_cast<std::uint8_t>(node.valid | (1u << k));
+    node.valid = static_cast<std::uint16_t>(node.valid | (1u << k));
+    if (!kid.leaf) node.inner = static_cast<std::uint16_t>(node.inner | (1u << k));
     node.child[k] = kid.leaf ? WideBvhNode::leaf(kid.index) : widen(bvh, nodes, kids[k]);
   }
   bvh.wide[static_cast<std::size_t>(index)] = node;
