@@ -41,8 +41,8 @@ enum class BvhUse : std::uint8_t { Auto, Always, Never };
 // A node of the tree: up to sixteen children, whose sixteen boxes the walk
 // tests against a ray at once (bvh_walk.inc's reach_children), one AVX-512
 // register an axis. Built as a binary tree by the surface-area heuristic, then
-// made wide by opening, at each node, the interior child of largest area
-// until there are sixteen: the same leaves, the same boxes. On the
+// made wide by the collapse of least surface-area cost (bvh.cpp's Collapse):
+// the same leaves, the same boxes. On the
 // many-lights room (483 objects in the tree) a ray visits 1.6 of these nodes
 // below the root, against 2.5 with eight children a node
 // (docs/many_lights.md).
